@@ -1,0 +1,106 @@
+//! Mesh file formats. Reading detects the format from the content (the name is only a hint), and
+//! every malformed input becomes an [`Error`] saying what and where, never a panic. Declared counts
+//! in headers are never trusted for allocation: readers grow as data actually arrives.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+
+/// Formats we read and write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    Obj,
+    /// glTF 2.0 JSON with embedded (`data:`) buffers.
+    Gltf,
+    /// Binary glTF.
+    Glb,
+    Ply,
+    Stl,
+    Off,
+}
+
+impl Format {
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Obj => "obj",
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
+            Format::Ply => "ply",
+            Format::Stl => "stl",
+            Format::Off => "off",
+        }
+    }
+
+    pub fn mime(self) -> &'static str {
+        match self {
+            Format::Obj => "model/obj",
+            Format::Gltf => "model/gltf+json",
+            Format::Glb => "model/gltf-binary",
+            Format::Ply => "application/x-ply",
+            Format::Stl => "model/stl",
+            Format::Off => "application/x-off",
+        }
+    }
+
+    /// From a file extension or short name (`"glb"`, `"OBJ"`, `"mesh.ply"`).
+    pub fn from_name(name: &str) -> Option<Format> {
+        let ext = name.rsplit('.').next().unwrap_or(name).to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "obj" => Format::Obj,
+            "gltf" => Format::Gltf,
+            "glb" => Format::Glb,
+            "ply" => Format::Ply,
+            "stl" => Format::Stl,
+            "off" => Format::Off,
+            _ => return None,
+        })
+    }
+
+    /// From a MIME type (parameters after `;` ignored).
+    pub fn from_mime(mime: &str) -> Option<Format> {
+        let m = mime.split(';').next().unwrap_or("").trim().to_ascii_lowercase();
+        Some(match m.as_str() {
+            "model/obj" | "text/plain+obj" | "application/x-tgif" => Format::Obj,
+            "model/gltf+json" => Format::Gltf,
+            "model/gltf-binary" => Format::Glb,
+            "application/x-ply" | "application/ply" | "model/x-ply" => Format::Ply,
+            "model/stl" | "application/sla" | "model/x.stl-binary" | "model/x.stl-ascii" => Format::Stl,
+            "application/x-off" | "model/off" => Format::Off,
+            _ => return None,
+        })
+    }
+}
+
+/// Limits enforced while reading, before anything big is allocated.
+#[derive(Debug, Clone)]
+pub struct ReadOptions {
+    /// File name or extension, used only when the content is ambiguous.
+    pub name_hint: Option<String>,
+    pub max_vertices: usize,
+    pub max_faces: usize,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions { name_hint: None, max_vertices: 50_000_000, max_faces: 100_000_000 }
+    }
+}
+
+/// A mesh as read, with the detected format and anything the reader had to say about it
+/// (attributes it could not keep, primitives it skipped and why).
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub mesh: Mesh,
+    pub format: Format,
+    pub warnings: Vec<String>,
+}
+
+/// Reads a mesh from bytes, detecting the format from the content.
+pub fn read(_bytes: &[u8], _opts: &ReadOptions) -> Result<Loaded> {
+    Err(Error::UnsupportedFormat("readers not implemented yet".into()))
+}
+
+/// Writes a mesh in the given format.
+pub fn write(_mesh: &Mesh, format: Format) -> Result<Vec<u8>> {
+    Err(Error::UnsupportedFormat(format!("writing {} not implemented yet", format.extension())))
+}

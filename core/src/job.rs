@@ -1,0 +1,261 @@
+//! What every job shares: progress/cancellation, per-stage timings, the output, and the one
+//! dispatcher the CLI and the HTTP service both call (so both get the same schema, defaults and
+//! validation).
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+
+/// Shared between a running job and whoever watches it (CLI progress line, HTTP status endpoint).
+/// Cloning is cheap; all clones see the same state. Jobs call [`Progress::check`] in every loop so
+/// that cancellation and time limits take effect at the next iteration.
+#[derive(Clone, Default)]
+pub struct Progress {
+    inner: Arc<ProgressInner>,
+}
+
+#[derive(Default)]
+struct ProgressInner {
+    cancelled: AtomicBool,
+    deadline: Mutex<Option<Instant>>,
+    stage: Mutex<String>,
+    fraction_bits: AtomicU64,
+    listener: Mutex<Option<Listener>>,
+}
+
+type Listener = Box<dyn Fn(&str, f64) + Send + Sync>;
+
+impl Progress {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// After `deadline`, [`Progress::check`] fails with [`Error::TimedOut`].
+    pub fn set_deadline(&self, deadline: Instant) {
+        *lock(&self.inner.deadline) = Some(deadline);
+    }
+
+    /// Called on every stage change and fraction update (keep it cheap).
+    pub fn set_listener(&self, f: impl Fn(&str, f64) + Send + Sync + 'static) {
+        *lock(&self.inner.listener) = Some(Box::new(f));
+    }
+
+    pub fn cancel(&self) {
+        self.inner.cancelled.store(true, Ordering::Relaxed);
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.inner.cancelled.load(Ordering::Relaxed)
+    }
+
+    /// Err when the job should stop now: cancelled or past its deadline.
+    pub fn check(&self) -> Result<()> {
+        if self.is_cancelled() {
+            return Err(Error::Cancelled);
+        }
+        if let Some(d) = *lock(&self.inner.deadline) {
+            if Instant::now() >= d {
+                return Err(Error::TimedOut);
+            }
+        }
+        Ok(())
+    }
+
+    /// Enters a new stage (fraction resets to 0) and checks for cancellation.
+    pub fn stage(&self, name: &str) -> Result<()> {
+        *lock(&self.inner.stage) = name.to_string();
+        self.inner.fraction_bits.store(0f64.to_bits(), Ordering::Relaxed);
+        self.notify();
+        self.check()
+    }
+
+    /// Fraction of the current stage done, 0..=1; also checks for cancellation.
+    pub fn fraction(&self, f: f64) -> Result<()> {
+        self.inner.fraction_bits.store(f.clamp(0.0, 1.0).to_bits(), Ordering::Relaxed);
+        self.notify();
+        self.check()
+    }
+
+    /// (stage, fraction) as last reported.
+    pub fn snapshot(&self) -> (String, f64) {
+        (lock(&self.inner.stage).clone(), f64::from_bits(self.inner.fraction_bits.load(Ordering::Relaxed)))
+    }
+
+    fn notify(&self) {
+        if let Some(l) = lock(&self.inner.listener).as_ref() {
+            let (s, f) = self.snapshot();
+            l(&s, f);
+        }
+    }
+}
+
+/// Locks a mutex, recovering the data if a panicking thread poisoned it (progress state is plain
+/// data; a panic elsewhere must not turn every later status call into a second panic).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Wall-clock time per stage, in the order the stages ran; serialised into every report.
+#[derive(Debug, Clone)]
+pub struct Stages {
+    start: Instant,
+    stages: Vec<(String, f64)>,
+}
+
+impl Default for Stages {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Stages {
+    pub fn new() -> Self {
+        Stages { start: Instant::now(), stages: Vec::new() }
+    }
+
+    /// Runs `f` as stage `name`, telling `progress` and recording its duration.
+    pub fn run<T>(&mut self, progress: &Progress, name: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        progress.stage(name)?;
+        let t = Instant::now();
+        let r = f()?;
+        self.stages.push((name.to_string(), t.elapsed().as_secs_f64() * 1e3));
+        Ok(r)
+    }
+
+    pub fn total_ms(&self) -> f64 {
+        self.start.elapsed().as_secs_f64() * 1e3
+    }
+
+    /// `{"stage": ms, …}` in run order.
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut m = serde_json::Map::new();
+        for (k, v) in &self.stages {
+            m.insert(k.clone(), serde_json::json!(round3(*v)));
+        }
+        serde_json::Value::Object(m)
+    }
+}
+
+fn round3(x: f64) -> f64 {
+    (x * 1e3).round() / 1e3
+}
+
+/// What a job hands back: zero or more meshes and a JSON report.
+#[derive(Debug, Clone, Default)]
+pub struct Output {
+    pub meshes: Vec<Mesh>,
+    pub report: serde_json::Value,
+}
+
+/// The jobs the CLI and the service expose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum JobKind {
+    /// Validation report only; no mesh out.
+    Validate,
+    /// Read and write again (format conversion); no change to the mesh.
+    Convert,
+    Repair,
+    Smooth,
+}
+
+impl JobKind {
+    pub const ALL: [JobKind; 4] = [JobKind::Validate, JobKind::Convert, JobKind::Repair, JobKind::Smooth];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            JobKind::Validate => "validate",
+            JobKind::Convert => "convert",
+            JobKind::Repair => "repair",
+            JobKind::Smooth => "smooth",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<JobKind> {
+        JobKind::ALL.into_iter().find(|k| k.name() == s)
+    }
+
+    /// How many input meshes the job takes (min, max).
+    pub fn inputs(self) -> (usize, usize) {
+        (1, 1)
+    }
+
+    /// Whether the job produces a mesh (validate produces only a report).
+    pub fn returns_mesh(self) -> bool {
+        !matches!(self, JobKind::Validate)
+    }
+}
+
+/// Deserialises `params` for a job, naming the offending field on error.
+pub fn parse_params<P: serde::de::DeserializeOwned>(params: serde_json::Value) -> Result<P> {
+    let params = if params.is_null() { serde_json::Value::Object(Default::default()) } else { params };
+    serde_json::from_value(params).map_err(|e| {
+        let msg = e.to_string();
+        // serde's messages name the field ("unknown field `foo`", "invalid type … for `bar`").
+        let field = msg.split('`').nth(1).unwrap_or("params").to_string();
+        Error::params(field, msg)
+    })
+}
+
+/// Runs a job on already-read meshes. The one entry point for the CLI and the service.
+pub fn run(kind: JobKind, mut inputs: Vec<Mesh>, params: serde_json::Value, progress: &Progress) -> Result<Output> {
+    let (lo, hi) = kind.inputs();
+    if inputs.len() < lo || inputs.len() > hi {
+        return Err(Error::params(
+            "inputs",
+            format!("{} takes {lo}..={hi} meshes, got {}", kind.name(), inputs.len()),
+        ));
+    }
+    match kind {
+        JobKind::Validate => crate::validate::run(&inputs[0], &parse_params(params)?, progress),
+        JobKind::Convert => {
+            let _: EmptyParams = parse_params(params)?;
+            let mut stages = Stages::new();
+            let mesh = stages.run(progress, "convert", || Ok(inputs.swap_remove(0)))?;
+            let report = serde_json::json!({
+                "vertices": mesh.vertex_count(),
+                "faces": mesh.face_count(),
+                "total_ms": stages.total_ms(),
+                "stages": stages.to_json(),
+            });
+            Ok(Output { meshes: vec![mesh], report })
+        }
+        JobKind::Repair => crate::repair::run(inputs.swap_remove(0), &parse_params(params)?, progress),
+        JobKind::Smooth => crate::smooth::run(inputs.swap_remove(0), &parse_params(params)?, progress),
+    }
+}
+
+/// Parameters of a job that takes none; unknown fields are still refused.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EmptyParams {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cancel_and_deadline_stop_check() {
+        let p = Progress::new();
+        assert!(p.check().is_ok());
+        p.cancel();
+        assert!(matches!(p.check(), Err(Error::Cancelled)));
+        let q = Progress::new();
+        q.set_deadline(Instant::now());
+        assert!(matches!(q.check(), Err(Error::TimedOut)));
+    }
+
+    #[test]
+    fn unknown_param_is_named() {
+        let e = parse_params::<EmptyParams>(serde_json::json!({"bogus": 1})).unwrap_err();
+        match e {
+            Error::InvalidParams { field, .. } => assert_eq!(field, "bogus"),
+            other => panic!("{other:?}"),
+        }
+    }
+}

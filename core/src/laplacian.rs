@@ -1,0 +1,1 @@
+//! Discrete Laplace operators and mass matrices (uniform, cotangent, hybrid quad/triangle, boundary).

@@ -1,0 +1,241 @@
+//! The mesh data every job works on.
+//!
+//! Positions are f64. Faces keep the arity they were given (triangles, quads, n-gons) in one compact
+//! offsets + indices store, each face carrying the id of the group it belongs to (OBJ `g`/`o`, glTF
+//! primitive), so partitions survive a round trip. Vertex indices are those of the input file, so a
+//! user's "template vertex 12" means the same vertex everywhere.
+//!
+//! Topology (adjacency, boundaries, …) is *not* stored here: it is derived on demand by
+//! [`crate::topology`] so that it can never drift from the face list.
+
+use crate::error::{Error, Location, Result};
+
+pub type Point3 = [f64; 3];
+
+/// Faces of any arity, stored as offsets into one index array, with a group id per face.
+///
+/// Invariants (kept by the only mutating method, [`Faces::push`]): `offsets[0] == 0`,
+/// `offsets` is non-decreasing, `offsets.len() == groups.len() + 1`, every face has ≥ 1 index
+/// (the reader rejects or reports faces with < 3; repair may produce none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Faces {
+    offsets: Vec<u32>,
+    indices: Vec<u32>,
+    groups: Vec<u32>,
+}
+
+impl Default for Faces {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Faces {
+    pub fn new() -> Self {
+        Faces { offsets: vec![0], indices: Vec::new(), groups: Vec::new() }
+    }
+
+    pub fn with_capacity(faces: usize, indices: usize) -> Self {
+        let mut offsets = Vec::with_capacity(faces + 1);
+        offsets.push(0);
+        Faces { offsets, indices: Vec::with_capacity(indices), groups: Vec::with_capacity(faces) }
+    }
+
+    /// Triangles from a flat index list (length a multiple of 3), all in group 0.
+    pub fn from_triangles(tris: &[[u32; 3]]) -> Self {
+        let mut f = Faces::with_capacity(tris.len(), tris.len() * 3);
+        for t in tris {
+            f.push(t, 0);
+        }
+        f
+    }
+
+    /// Appends one face. Panics only if the total index count passes u32::MAX, which the readers
+    /// prevent by their size limits.
+    pub fn push(&mut self, face: &[u32], group: u32) {
+        self.indices.extend_from_slice(face);
+        let end = u32::try_from(self.indices.len()).unwrap_or(u32::MAX);
+        self.offsets.push(end);
+        self.groups.push(group);
+    }
+
+    pub fn len(&self) -> usize {
+        self.groups.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.groups.is_empty()
+    }
+
+    /// The vertex indices of face `i`.
+    #[inline]
+    pub fn get(&self, i: usize) -> &[u32] {
+        &self.indices[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    #[inline]
+    pub fn arity(&self, i: usize) -> usize {
+        (self.offsets[i + 1] - self.offsets[i]) as usize
+    }
+
+    #[inline]
+    pub fn group(&self, i: usize) -> u32 {
+        self.groups[i]
+    }
+
+    pub fn groups(&self) -> &[u32] {
+        &self.groups
+    }
+
+    pub fn offsets(&self) -> &[u32] {
+        &self.offsets
+    }
+
+    /// All face indices back to back.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// Mutable access to the indices (for reindexing after a weld); arities cannot change.
+    pub fn indices_mut(&mut self) -> &mut [u32] {
+        &mut self.indices
+    }
+
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
+        self.offsets.windows(2).map(move |w| &self.indices[w[0] as usize..w[1] as usize])
+    }
+
+    /// True when every face is a triangle (the fast paths of the solvers use this).
+    pub fn all_triangles(&self) -> bool {
+        self.indices.len() == 3 * self.len()
+    }
+
+    /// The flat index list viewed as triangles, when every face is one.
+    pub fn as_triangles(&self) -> Option<&[u32]> {
+        self.all_triangles().then_some(&self.indices[..])
+    }
+
+    /// Keeps the faces for which `keep(face_index)` is true, in order.
+    pub fn retain(&mut self, mut keep: impl FnMut(usize) -> bool) {
+        let mut out = Faces::with_capacity(self.len(), self.indices.len());
+        for i in 0..self.len() {
+            if keep(i) {
+                out.push(self.get(i), self.groups[i]);
+            }
+        }
+        *self = out;
+    }
+}
+
+/// A polygon mesh with optional per-vertex attributes, named face groups and polylines.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<Point3>,
+    pub faces: Faces,
+    /// Per-vertex normals, same length as `positions` when present.
+    pub normals: Option<Vec<Point3>>,
+    /// Per-vertex texture coordinates, same length as `positions` when present.
+    pub uvs: Option<Vec<[f64; 2]>>,
+    /// Group names; a face's group id indexes this list. Empty means one unnamed group 0.
+    pub groups: Vec<String>,
+    /// Polylines (OBJ `l`, glTF LINES/LINE_STRIP) as vertex index lists into `positions`.
+    pub curves: Vec<Vec<u32>>,
+}
+
+impl Mesh {
+    pub fn new(positions: Vec<Point3>, faces: Faces) -> Self {
+        Mesh { positions, faces, ..Default::default() }
+    }
+
+    /// A triangle mesh in one unnamed group.
+    pub fn from_triangles(positions: Vec<Point3>, tris: &[[u32; 3]]) -> Self {
+        Mesh::new(positions, Faces::from_triangles(tris))
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Name of a group id ("" when the mesh has no names).
+    pub fn group_name(&self, id: u32) -> &str {
+        self.groups.get(id as usize).map(String::as_str).unwrap_or("")
+    }
+
+    /// Checks the structural invariants a reader must establish: indices in range, attribute
+    /// lengths, finite coordinates, group ids named. Readers call this before handing a mesh out,
+    /// so jobs may index without bounds worries.
+    pub fn check(&self) -> Result<()> {
+        let n = self.positions.len();
+        if let Some(i) = self.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(Error::InvalidMesh {
+                location: Location::Vertex(i),
+                message: "coordinate is NaN or infinite".into(),
+            });
+        }
+        for (fi, f) in self.faces.iter().enumerate() {
+            if let Some(&bad) = f.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidMesh {
+                    location: Location::Face(fi),
+                    message: format!("vertex index {bad} out of range (mesh has {n} vertices)"),
+                });
+            }
+        }
+        for (ci, c) in self.curves.iter().enumerate() {
+            if let Some(&bad) = c.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidMesh {
+                    location: Location::Vertex(bad as usize),
+                    message: format!("curve {ci} refers to vertex {bad}, mesh has {n} vertices"),
+                });
+            }
+        }
+        if let Some(nr) = &self.normals {
+            if nr.len() != n {
+                return Err(Error::Internal(format!("{} normals for {n} vertices", nr.len())));
+            }
+        }
+        if let Some(uv) = &self.uvs {
+            if uv.len() != n {
+                return Err(Error::Internal(format!("{} uvs for {n} vertices", uv.len())));
+            }
+        }
+        if !self.groups.is_empty() {
+            if let Some(fi) = self.faces.groups().iter().position(|&g| g as usize >= self.groups.len()) {
+                return Err(Error::Internal(format!("face {fi} has an unnamed group id")));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faces_keep_arity_and_groups() {
+        let mut f = Faces::new();
+        f.push(&[0, 1, 2], 0);
+        f.push(&[0, 2, 3, 4], 1);
+        assert_eq!(f.len(), 2);
+        assert_eq!(f.get(1), &[0, 2, 3, 4]);
+        assert_eq!(f.arity(0), 3);
+        assert_eq!(f.group(1), 1);
+        assert!(!f.all_triangles());
+        f.retain(|i| i == 1);
+        assert_eq!(f.len(), 1);
+        assert_eq!(f.get(0), &[0, 2, 3, 4]);
+    }
+
+    #[test]
+    fn check_rejects_out_of_range_and_nan() {
+        let mut m = Mesh::from_triangles(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 3]]);
+        assert!(matches!(m.check(), Err(Error::InvalidMesh { location: Location::Face(0), .. })));
+        m.faces = Faces::from_triangles(&[[0, 1, 2]]);
+        m.positions[1][2] = f64::NAN;
+        assert!(matches!(m.check(), Err(Error::InvalidMesh { location: Location::Vertex(1), .. })));
+    }
+}

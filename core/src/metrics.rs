@@ -1,0 +1,1 @@
+//! Quality measures: Hausdorff distance, angle statistics, flipped faces, volume/area change.

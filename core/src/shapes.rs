@@ -1,0 +1,236 @@
+//! Analytic shapes for tests and benchmarks: their true geometry is known independently of any
+//! code under test (a sphere's radius, a plane's normal, a grid's spacing).
+
+use std::collections::HashMap;
+
+use crate::geometry::{normalize, scale};
+use crate::mesh::{Faces, Mesh, Point3};
+
+/// Icosahedron subdivided `levels` times, vertices projected on the sphere of `radius` about the
+/// origin. V = 10·4^levels + 2, F = 20·4^levels, outward-oriented, closed, genus 0.
+pub fn icosphere(levels: u32, radius: f64) -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut pos: Vec<Point3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|&p| normalize(p))
+    .collect();
+    let mut tris: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        tris = split_triangles(&mut pos, &tris, |p| normalize(p));
+    }
+    let pos = pos.into_iter().map(|p| scale(p, radius)).collect();
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// One 1→4 midpoint subdivision of every triangle; `place` maps each new midpoint (e.g. onto a
+/// sphere). Shared edges get one midpoint, so a closed mesh stays closed.
+fn split_triangles(pos: &mut Vec<Point3>, tris: &[[u32; 3]], place: impl Fn(Point3) -> Point3) -> Vec<[u32; 3]> {
+    let mut mid: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3 / 2);
+    let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Point3>| -> u32 {
+        let key = (a.min(b), a.max(b));
+        *mid.entry(key).or_insert_with(|| {
+            let (pa, pb) = (pos[a as usize], pos[b as usize]);
+            pos.push(place([(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0, (pa[2] + pb[2]) / 2.0]));
+            (pos.len() - 1) as u32
+        })
+    };
+    let mut out = Vec::with_capacity(tris.len() * 4);
+    for &[a, b, c] in tris {
+        let ab = midpoint(a, b, pos);
+        let bc = midpoint(b, c, pos);
+        let ca = midpoint(c, a, pos);
+        out.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+    }
+    out
+}
+
+/// Midpoint (1→4) subdivision of a triangle mesh `levels` times, geometry unchanged (new vertices
+/// on the old edges). Used to make million-vertex benchmark inputs from real scans.
+/// Non-triangle faces are fan-triangulated first.
+pub fn subdivide_midpoint(mesh: &Mesh, levels: u32) -> Mesh {
+    let mut pos = mesh.positions.clone();
+    let mut tris = fan_triangles(&mesh.faces);
+    for _ in 0..levels {
+        tris = split_triangles(&mut pos, &tris, |p| p);
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// Faces fan-triangulated from their first corner.
+pub fn fan_triangles(faces: &Faces) -> Vec<[u32; 3]> {
+    let mut tris = Vec::with_capacity(faces.len());
+    for f in faces.iter() {
+        for k in 1..f.len().saturating_sub(1) {
+            tris.push([f[0], f[k], f[k + 1]]);
+        }
+    }
+    tris
+}
+
+/// A planar grid in z = 0 of `nx × ny` cells with spacing `h`, as quads (`quads = true`) or as
+/// triangles (each cell split along the diagonal from its lower-left corner). Vertex (i, j) has
+/// index `j * (nx + 1) + i` and position (i·h, j·h, 0). Faces are oriented with normal +z.
+pub fn grid(nx: usize, ny: usize, h: f64, quads: bool) -> Mesh {
+    parallelogram_grid(nx, ny, [h, 0.0, 0.0], [0.0, h, 0.0], quads)
+}
+
+/// Like [`grid`] but with cell edge vectors `u` and `v` (a sheared grid gives parallelogram cells).
+pub fn parallelogram_grid(nx: usize, ny: usize, u: Point3, v: Point3, quads: bool) -> Mesh {
+    let mut pos = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let (fi, fj) = (i as f64, j as f64);
+            pos.push([fi * u[0] + fj * v[0], fi * u[1] + fj * v[1], fi * u[2] + fj * v[2]]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut faces = Faces::with_capacity(nx * ny * 2, nx * ny * 6);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if quads {
+                faces.push(&[a, b, c, d], 0);
+            } else {
+                faces.push(&[a, b, c], 0);
+                faces.push(&[a, c, d], 0);
+            }
+        }
+    }
+    Mesh::new(pos, faces)
+}
+
+/// Equilateral triangle grid of `nx × ny` vertices with edge length `h` (rows offset by h/2):
+/// every interior vertex has valence 6 and all angles are 60°.
+pub fn triangle_grid(nx: usize, ny: usize, h: f64) -> Mesh {
+    let dy = h * 3f64.sqrt() / 2.0;
+    let mut pos = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        let off = if j % 2 == 1 { h / 2.0 } else { 0.0 };
+        for i in 0..nx {
+            pos.push([i as f64 * h + off, j as f64 * dy, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * nx + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..ny.saturating_sub(1) {
+        for i in 0..nx.saturating_sub(1) {
+            if j % 2 == 0 {
+                tris.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
+                tris.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            } else {
+                tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+                tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            }
+        }
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// Torus about the z axis with major radius `r_major`, minor `r_minor`, `nu × nv` quads
+/// (triangulated when `quads` is false). Closed, genus 1, outward-oriented.
+pub fn torus(nu: usize, nv: usize, r_major: f64, r_minor: f64, quads: bool) -> Mesh {
+    let mut pos = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        let u = i as f64 / nu as f64 * std::f64::consts::TAU;
+        for j in 0..nv {
+            let v = j as f64 / nv as f64 * std::f64::consts::TAU;
+            let r = r_major + r_minor * v.cos();
+            pos.push([r * u.cos(), r * u.sin(), r_minor * v.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    let mut faces = Faces::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if quads {
+                faces.push(&[a, b, c, d], 0);
+            } else {
+                faces.push(&[a, b, c], 0);
+                faces.push(&[a, c, d], 0);
+            }
+        }
+    }
+    Mesh::new(pos, faces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{norm, signed_volume};
+
+    #[test]
+    fn icosphere_counts_radius_and_volume() {
+        let m = icosphere(3, 2.0);
+        assert_eq!(m.vertex_count(), 10 * 64 + 2);
+        assert_eq!(m.face_count(), 20 * 64);
+        assert!(m.positions.iter().all(|p| (norm(*p) - 2.0).abs() < 1e-12));
+        let v = signed_volume(&m.positions, &m.faces);
+        let exact = 4.0 / 3.0 * std::f64::consts::PI * 8.0;
+        // Inscribed polyhedron: slightly less than the sphere, and outward-oriented (positive).
+        assert!(v > 0.97 * exact && v < exact, "{v} vs {exact}");
+    }
+
+    #[test]
+    fn subdivision_keeps_shape_and_counts() {
+        let m = icosphere(1, 1.0);
+        let s = subdivide_midpoint(&m, 2);
+        assert_eq!(s.face_count(), m.face_count() * 16);
+        // Euler: V - E + F = 2 and E = 3F/2 for a closed triangle mesh.
+        assert_eq!(s.vertex_count() as i64 - 3 * s.face_count() as i64 / 2 + s.face_count() as i64, 2);
+        let (v0, v1) = (signed_volume(&m.positions, &m.faces), signed_volume(&s.positions, &s.faces));
+        assert!((v0 - v1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn torus_is_genus_one_by_euler() {
+        let t = torus(12, 8, 2.0, 0.5, true);
+        let (v, f) = (t.vertex_count() as i64, t.face_count() as i64);
+        assert_eq!(v - 2 * f + f, 0); // quads: E = 2F
+        assert!(signed_volume(&t.positions, &t.faces) > 0.0);
+    }
+
+    #[test]
+    fn grid_indexing() {
+        let g = grid(3, 2, 0.5, true);
+        assert_eq!(g.vertex_count(), 12);
+        assert_eq!(g.face_count(), 6);
+        assert_eq!(g.positions[4 + 2], [1.0, 0.5, 0.0]);
+        let t = triangle_grid(4, 3, 1.0);
+        assert_eq!(t.face_count(), 2 * 3 * 2);
+    }
+}

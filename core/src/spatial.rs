@@ -1,0 +1,1 @@
+//! Spatial queries: nearest vertex, closest point on a triangle mesh (AABB tree).
