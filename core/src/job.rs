@@ -145,11 +145,23 @@ fn round3(x: f64) -> f64 {
     (x * 1e3).round() / 1e3
 }
 
-/// What a job hands back: zero or more meshes and a JSON report.
+/// What a job hands back: zero or more meshes, files the job encoded itself, and a JSON report.
 #[derive(Debug, Clone, Default)]
 pub struct Output {
     pub meshes: Vec<Mesh>,
+    /// Files a plain [`Mesh`] cannot hold (the morph's animated GLB with morph targets). When
+    /// present, the service returns the first artifact instead of encoding `meshes[0]`.
+    pub artifacts: Vec<Artifact>,
     pub report: serde_json::Value,
+}
+
+/// A finished file produced by a job.
+#[derive(Debug, Clone)]
+pub struct Artifact {
+    /// Suggested file name, e.g. `morph.glb`.
+    pub name: String,
+    pub media_type: String,
+    pub bytes: Vec<u8>,
 }
 
 /// The jobs the CLI and the service expose.
@@ -162,10 +174,15 @@ pub enum JobKind {
     Convert,
     Repair,
     Smooth,
+    /// Deform a template so that it passes through a curve network (seed 000). Inputs: template, curves.
+    Fit,
+    /// Morph sequence between meshes of different connectivity (seeds 002/003). Inputs: 2 or more meshes.
+    Morph,
 }
 
 impl JobKind {
-    pub const ALL: [JobKind; 4] = [JobKind::Validate, JobKind::Convert, JobKind::Repair, JobKind::Smooth];
+    pub const ALL: [JobKind; 6] =
+        [JobKind::Validate, JobKind::Convert, JobKind::Repair, JobKind::Smooth, JobKind::Fit, JobKind::Morph];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -173,6 +190,8 @@ impl JobKind {
             JobKind::Convert => "convert",
             JobKind::Repair => "repair",
             JobKind::Smooth => "smooth",
+            JobKind::Fit => "fit",
+            JobKind::Morph => "morph",
         }
     }
 
@@ -182,7 +201,11 @@ impl JobKind {
 
     /// How many input meshes the job takes (min, max).
     pub fn inputs(self) -> (usize, usize) {
-        (1, 1)
+        match self {
+            JobKind::Fit => (2, 2),
+            JobKind::Morph => (2, 16),
+            _ => (1, 1),
+        }
     }
 
     /// Whether the job produces a mesh (validate produces only a report).
@@ -203,7 +226,12 @@ pub fn parse_params<P: serde::de::DeserializeOwned>(params: serde_json::Value) -
 }
 
 /// Runs a job on already-read meshes. The one entry point for the CLI and the service.
-pub fn run(kind: JobKind, mut inputs: Vec<Mesh>, params: serde_json::Value, progress: &Progress) -> Result<Output> {
+pub fn run(
+    kind: JobKind,
+    mut inputs: Vec<Mesh>,
+    params: serde_json::Value,
+    progress: &Progress,
+) -> Result<Output> {
     let (lo, hi) = kind.inputs();
     if inputs.len() < lo || inputs.len() > hi {
         return Err(Error::params(
@@ -223,10 +251,12 @@ pub fn run(kind: JobKind, mut inputs: Vec<Mesh>, params: serde_json::Value, prog
                 "total_ms": stages.total_ms(),
                 "stages": stages.to_json(),
             });
-            Ok(Output { meshes: vec![mesh], report })
+            Ok(Output { meshes: vec![mesh], report, ..Default::default() })
         }
         JobKind::Repair => crate::repair::run(inputs.swap_remove(0), &parse_params(params)?, progress),
         JobKind::Smooth => crate::smooth::run(inputs.swap_remove(0), &parse_params(params)?, progress),
+        JobKind::Fit => crate::fit::run(inputs, &parse_params(params)?, progress),
+        JobKind::Morph => crate::morph::run(inputs, &parse_params(params)?, progress),
     }
 }
 

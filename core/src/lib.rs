@@ -2,16 +2,19 @@
 //!
 //! The modules read like the pipeline: bytes come in through [`io`], become a [`mesh::Mesh`],
 //! are checked by [`validate`] and mended by [`repair`] (both on top of [`topology`]), and are then
-//! handed to a job ([`smooth`], later `fit` and `morph`). Every job has the shape
+//! handed to a job ([`smooth`], [`fit`], [`morph`]). Every job has the shape
 //! `run(input, &Params, &Progress) -> Result<Output, Error>` (see [`job`]).
 
 pub mod error;
+pub mod fit;
 pub mod geometry;
 pub mod io;
 pub mod job;
 pub mod laplacian;
 pub mod mesh;
 pub mod metrics;
+pub mod morph;
+pub mod register;
 pub mod repair;
 pub mod shapes;
 pub mod smooth;

@@ -58,7 +58,11 @@ pub fn icosphere(levels: u32, radius: f64) -> Mesh {
 
 /// One 1→4 midpoint subdivision of every triangle; `place` maps each new midpoint (e.g. onto a
 /// sphere). Shared edges get one midpoint, so a closed mesh stays closed.
-fn split_triangles(pos: &mut Vec<Point3>, tris: &[[u32; 3]], place: impl Fn(Point3) -> Point3) -> Vec<[u32; 3]> {
+fn split_triangles(
+    pos: &mut Vec<Point3>,
+    tris: &[[u32; 3]],
+    place: impl Fn(Point3) -> Point3,
+) -> Vec<[u32; 3]> {
     let mut mid: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3 / 2);
     let mut midpoint = |a: u32, b: u32, pos: &mut Vec<Point3>| -> u32 {
         let key = (a.min(b), a.max(b));

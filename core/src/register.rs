@@ -1,0 +1,1 @@
+//! Rigid/similarity registration of two meshes or point sets (PCA, ICP, Procrustes).
