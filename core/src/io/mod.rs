@@ -5,6 +5,12 @@
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
+pub mod gltf;
+pub mod obj;
+pub mod off;
+pub mod ply;
+pub mod stl;
+
 /// Formats we read and write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
 #[serde(rename_all = "lowercase")]
@@ -96,11 +102,33 @@ pub struct Loaded {
 }
 
 /// Reads a mesh from bytes, detecting the format from the content.
-pub fn read(_bytes: &[u8], _opts: &ReadOptions) -> Result<Loaded> {
-    Err(Error::UnsupportedFormat("readers not implemented yet".into()))
+pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
+    match detect(bytes, opts.name_hint.as_deref())? {
+        Format::Obj => obj::read(bytes, opts),
+        Format::Gltf | Format::Glb => gltf::read(bytes, opts),
+        Format::Ply => ply::read(bytes, opts),
+        Format::Stl => stl::read(bytes, opts),
+        Format::Off => off::read(bytes, opts),
+    }
+}
+
+/// The format of `bytes`, from magic numbers and content; `name_hint` only breaks ties.
+pub fn detect(bytes: &[u8], name_hint: Option<&str>) -> Result<Format> {
+    if bytes.starts_with(b"glTF") {
+        return Ok(Format::Glb);
+    }
+    let _ = name_hint;
+    Err(Error::UnsupportedFormat("format detection not implemented yet".into()))
 }
 
 /// Writes a mesh in the given format.
-pub fn write(_mesh: &Mesh, format: Format) -> Result<Vec<u8>> {
-    Err(Error::UnsupportedFormat(format!("writing {} not implemented yet", format.extension())))
+pub fn write(mesh: &Mesh, format: Format) -> Result<Vec<u8>> {
+    match format {
+        Format::Obj => obj::write(mesh),
+        Format::Glb => gltf::write_glb(mesh),
+        Format::Gltf => gltf::write_gltf(mesh),
+        Format::Ply => ply::write(mesh),
+        Format::Stl => stl::write(mesh),
+        Format::Off => off::write(mesh),
+    }
 }
