@@ -79,7 +79,10 @@ impl RbfWarp {
     }
 
     pub fn displacement(&self, x: Point3) -> Point3 {
-        let mut d = add(self.beta[0], add(scale(self.beta[1], x[0]), add(scale(self.beta[2], x[1]), scale(self.beta[3], x[2]))));
+        let mut d = add(
+            self.beta[0],
+            add(scale(self.beta[1], x[0]), add(scale(self.beta[2], x[1]), scale(self.beta[3], x[2]))),
+        );
         for (c, a) in self.centres.iter().zip(&self.alpha) {
             let r = norm(sub(x, *c));
             if r < self.radius {
@@ -185,7 +188,8 @@ pub fn align(
             let want: Vec<Point3> = start.iter().zip(&goals).map(|(&a, &g)| slerp(a, g, t)).collect();
             let disp: Vec<Point3> = want.iter().zip(&centres).map(|(&w, &c)| sub(w, c)).collect();
             let warp = RbfWarp::fit(&centres, &disp, s.support_radius)?;
-            let moved: Vec<Point3> = spheres[k].iter().map(|&x| normalize(add(x, warp.displacement(x)))).collect();
+            let moved: Vec<Point3> =
+                spheres[k].iter().map(|&x| normalize(add(x, warp.displacement(x)))).collect();
             if count_foldovers(&moved, tris[k]) == 0 {
                 spheres[k] = moved;
                 steps_done += 1;

@@ -96,5 +96,8 @@ pub fn bary_on_chord(a: Point3, b: Point3, c: Point3, p: Point3) -> [f64; 3] {
 }
 
 pub fn interpolate(pos: &[Point3], t: [u32; 3], w: [f64; 3]) -> Point3 {
-    add(add(scale(pos[t[0] as usize], w[0]), scale(pos[t[1] as usize], w[1])), scale(pos[t[2] as usize], w[2]))
+    add(
+        add(scale(pos[t[0] as usize], w[0]), scale(pos[t[1] as usize], w[1])),
+        scale(pos[t[2] as usize], w[2]),
+    )
 }

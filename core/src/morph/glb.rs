@@ -14,7 +14,10 @@ pub fn write(tris: &[[u32; 3]], shapes: &[Vec<Point3>], keys: &[(f32, Vec<f32>)]
     let mut accessors = Vec::new();
     // Base positions.
     let base: Vec<[f32; 3]> = shapes[0].iter().map(|p| p.map(|c| c as f32)).collect();
-    let push_vec3 = |bin: &mut Vec<u8>, data: &[[f32; 3]], views: &mut Vec<serde_json::Value>, accessors: &mut Vec<serde_json::Value>| {
+    let push_vec3 = |bin: &mut Vec<u8>,
+                     data: &[[f32; 3]],
+                     views: &mut Vec<serde_json::Value>,
+                     accessors: &mut Vec<serde_json::Value>| {
         let off = bin.len();
         let mut mn = [f32::INFINITY; 3];
         let mut mx = [f32::NEG_INFINITY; 3];
@@ -39,7 +42,11 @@ pub fn write(tris: &[[u32; 3]], shapes: &[Vec<Point3>], keys: &[(f32, Vec<f32>)]
     let pos_acc = push_vec3(&mut bin, &base, &mut views, &mut accessors);
     let mut target_accs = Vec::new();
     for s in &shapes[1..] {
-        let d: Vec<[f32; 3]> = s.iter().zip(&base).map(|(p, b)| [p[0] as f32 - b[0], p[1] as f32 - b[1], p[2] as f32 - b[2]]).collect();
+        let d: Vec<[f32; 3]> = s
+            .iter()
+            .zip(&base)
+            .map(|(p, b)| [p[0] as f32 - b[0], p[1] as f32 - b[1], p[2] as f32 - b[2]])
+            .collect();
         target_accs.push(push_vec3(&mut bin, &d, &mut views, &mut accessors));
     }
     // Indices.
@@ -49,7 +56,9 @@ pub fn write(tris: &[[u32; 3]], shapes: &[Vec<Point3>], keys: &[(f32, Vec<f32>)]
             bin.extend_from_slice(&v.to_le_bytes());
         }
     }
-    views.push(serde_json::json!({"buffer": 0, "byteOffset": off, "byteLength": tris.len() * 12, "target": 34963}));
+    views.push(
+        serde_json::json!({"buffer": 0, "byteOffset": off, "byteLength": tris.len() * 12, "target": 34963}),
+    );
     accessors.push(serde_json::json!({
         "bufferView": views.len() - 1, "componentType": 5125, "count": tris.len() * 3, "type": "SCALAR",
         "max": [n.saturating_sub(1)], "min": [0],
@@ -76,7 +85,9 @@ pub fn write(tris: &[[u32; 3]], shapes: &[Vec<Point3>], keys: &[(f32, Vec<f32>)]
                 bin.extend_from_slice(&w.get(k).copied().unwrap_or(0.0).to_le_bytes());
             }
         }
-        views.push(serde_json::json!({"buffer": 0, "byteOffset": off, "byteLength": keys.len() * targets * 4}));
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": off, "byteLength": keys.len() * targets * 4}),
+        );
         accessors.push(serde_json::json!({
             "bufferView": views.len() - 1, "componentType": 5126, "count": keys.len() * targets, "type": "SCALAR",
         }));
@@ -87,9 +98,12 @@ pub fn write(tris: &[[u32; 3]], shapes: &[Vec<Point3>], keys: &[(f32, Vec<f32>)]
             "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}}],
         }]);
     }
-    let mut primitive = serde_json::json!({"attributes": {"POSITION": pos_acc}, "indices": idx_acc, "mode": 4});
+    let mut primitive =
+        serde_json::json!({"attributes": {"POSITION": pos_acc}, "indices": idx_acc, "mode": 4});
     if targets > 0 {
-        primitive["targets"] = serde_json::Value::Array(target_accs.iter().map(|&a| serde_json::json!({"POSITION": a})).collect());
+        primitive["targets"] = serde_json::Value::Array(
+            target_accs.iter().map(|&a| serde_json::json!({"POSITION": a})).collect(),
+        );
     }
     let mut mesh = serde_json::json!({"name": "morph", "primitives": [primitive]});
     if targets > 0 {

@@ -15,7 +15,10 @@ pub fn frame_position(j: usize, frames: usize, shapes: usize) -> (usize, f64) {
 pub fn frame(shapes: &[Vec<Point3>], leg: usize, t: f64) -> Vec<Point3> {
     let a = &shapes[leg];
     let b = &shapes[(leg + 1).min(shapes.len() - 1)];
-    a.iter().zip(b).map(|(p, q)| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2])]).collect()
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), p[2] + t * (q[2] - p[2])])
+        .collect()
 }
 
 /// Σ wₖ·shapeₖ with weights normalised to sum 1 (affine combination).

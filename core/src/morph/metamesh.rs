@@ -156,7 +156,12 @@ pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, Over
                 for j in 0..3 {
                     let (b0, b1) = canon(tb[j], tb[(j + 1) % 3]);
                     if crosses(sa, a0, a1, sb, b0, b1) {
-                        let p = crossing_point(sa[a0 as usize], sa[a1 as usize], sb[b0 as usize], sb[b1 as usize]);
+                        let p = crossing_point(
+                            sa[a0 as usize],
+                            sa[a1 as usize],
+                            sb[b0 as usize],
+                            sb[b1 as usize],
+                        );
                         corners.push((Label::X(a0, a1, b0, b1), p, fa as u32, fb));
                     }
                 }
@@ -178,7 +183,11 @@ pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, Over
             }
             // Order the corners around the polygon's centre (it is convex).
             let c = normalize(corners.iter().fold([0.0; 3], |s, x| add(s, x.1)));
-            let e1 = normalize(if c[0].abs() < 0.9 { cross(c, [1.0, 0.0, 0.0]) } else { cross(c, [0.0, 1.0, 0.0]) });
+            let e1 = normalize(if c[0].abs() < 0.9 {
+                cross(c, [1.0, 0.0, 0.0])
+            } else {
+                cross(c, [0.0, 1.0, 0.0])
+            });
             let e2 = cross(c, e1);
             corners.sort_by(|x, y| {
                 let ax = dot(x.1, e2).atan2(dot(x.1, e1));
@@ -216,7 +225,16 @@ pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, Over
 }
 
 #[allow(clippy::too_many_arguments)]
-fn push_shapes(shapes: &mut [Vec<Point3>], ka: usize, a: &Layer, b: &Layer, label: Label, p: Point3, fa: u32, fb: u32) {
+fn push_shapes(
+    shapes: &mut [Vec<Point3>],
+    ka: usize,
+    a: &Layer,
+    b: &Layer,
+    label: Label,
+    p: Point3,
+    fa: u32,
+    fb: u32,
+) {
     let ta = a.tris[fa as usize];
     let tb = b.tris[fb as usize];
     let (sa, sb) = (&a.sphere, &b.sphere);
@@ -273,7 +291,10 @@ fn check_closed_manifold(tris: &[[u32; 3]], nv: usize) -> Result<()> {
     if bad > 0 || used != nv {
         return Err(Error::numerical(
             "metamesh",
-            format!("overlay is not a closed manifold ({bad} unmatched half-edges, {} unused vertices)", nv - used),
+            format!(
+                "overlay is not a closed manifold ({bad} unmatched half-edges, {} unused vertices)",
+                nv - used
+            ),
         ));
     }
     Ok(())

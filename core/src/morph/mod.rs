@@ -202,7 +202,10 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
                 });
             }
             if params.repair {
-                return Err(Error::params("repair", "repair before morphing is not available in this build yet"));
+                return Err(Error::params(
+                    "repair",
+                    "repair before morphing is not available in this build yet",
+                ));
             }
             let (mut t, map, conv) = TriMesh::from_mesh(m);
             let info = trimesh::topology(&t);
@@ -279,8 +282,16 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
 
     // 3. Parameterise every input (in parallel: they are independent).
     let settings = param::ParamSettings {
-        working_vertices: if params.param_method == ParamMethod::Tetrahedron { 4 } else { params.working_vertices },
-        max_flatten_rounds: if params.param_method == ParamMethod::Tetrahedron { 0 } else { params.max_flatten_rounds },
+        working_vertices: if params.param_method == ParamMethod::Tetrahedron {
+            4
+        } else {
+            params.working_vertices
+        },
+        max_flatten_rounds: if params.param_method == ParamMethod::Tetrahedron {
+            0
+        } else {
+            params.max_flatten_rounds
+        },
         relax_sweeps: params.relax_sweeps,
         final_relax_sweeps: params.final_relax_sweeps,
     };
@@ -310,7 +321,10 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         )
     })?;
     if align_rep.foldovers > 0 {
-        return Err(Error::numerical("align_features", format!("{} flipped triangles after the warp", align_rep.foldovers)));
+        return Err(Error::numerical(
+            "align_features",
+            format!("{} flipped triangles after the warp", align_rep.foldovers),
+        ));
     }
 
     // 5. Correspondence: chain overlays (or transfers) through the inputs.
@@ -371,7 +385,14 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     // 8. Report: how well the end frames reproduce the inputs (in the normalised frames).
     let hausdorff = stages.run(progress, "report", || {
         Ok((0..k_in)
-            .map(|k| report::relative_hausdorff(&layer.shapes[k], &layer.tris, &normalised[k].pos, &normalised[k].tris))
+            .map(|k| {
+                report::relative_hausdorff(
+                    &layer.shapes[k],
+                    &layer.tris,
+                    &normalised[k].pos,
+                    &normalised[k].tris,
+                )
+            })
             .collect::<Vec<f64>>())
     })?;
 
@@ -415,7 +436,11 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     });
     Ok(Output {
         meshes: out_meshes,
-        artifacts: vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }],
+        artifacts: vec![Artifact {
+            name: "morph.glb".into(),
+            media_type: "model/gltf-binary".into(),
+            bytes: glb_bytes,
+        }],
         report,
     })
 }

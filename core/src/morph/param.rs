@@ -30,8 +30,13 @@ use super::simplify::Hierarchy;
 use super::trimesh::TriMesh;
 
 /// f64 ordered for a max-heap.
-#[derive(PartialEq, PartialOrd)]
+#[derive(PartialEq)]
 struct Key(f64);
+impl PartialOrd for Key {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
 impl Eq for Key {}
 impl Ord for Key {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
@@ -86,7 +91,12 @@ pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> R
     rep.working_vertices = h.alive_vertices;
     let mut sphere = vec![[0.0; 3]; n];
     let (map, tris) = h.current();
-    match flatten_to_star(&map.iter().map(|&v| mesh.pos[v as usize]).collect::<Vec<_>>(), &tris, s.max_flatten_rounds, progress)? {
+    match flatten_to_star(
+        &map.iter().map(|&v| mesh.pos[v as usize]).collect::<Vec<_>>(),
+        &tris,
+        s.max_flatten_rounds,
+        progress,
+    )? {
         Ok((embedded, rounds)) => {
             rep.method = "curvature_flattening".into();
             rep.flatten_rounds = rounds;
@@ -177,7 +187,8 @@ fn flatten_to_star(
     }
     let nbrs: Vec<Vec<u32>> = (0..n)
         .map(|v| {
-            let mut w: Vec<u32> = vf[v].iter().flat_map(|&f| tris[f as usize]).filter(|&w| w as usize != v).collect();
+            let mut w: Vec<u32> =
+                vf[v].iter().flat_map(|&f| tris[f as usize]).filter(|&w| w as usize != v).collect();
             w.sort_unstable();
             w.dedup();
             w
@@ -187,7 +198,10 @@ fn flatten_to_star(
     for round in 1..=max_rounds {
         progress.fraction(round as f64 / max_rounds as f64)?;
         // χ_s: average triangle area (eq. IV.62), refreshed each round as the shape shrinks.
-        let chi = tris.iter().map(|t| triangle_area(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize])).sum::<f64>()
+        let chi = tris
+            .iter()
+            .map(|t| triangle_area(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+            .sum::<f64>()
             / tris.len() as f64;
         let ks = |p: &[Point3], v: usize| -> f64 {
             let mut ang = 0.0;
@@ -216,7 +230,10 @@ fn flatten_to_star(
                     continue;
                 }
                 let v = v as usize;
-                let bary = scale(nbrs[v].iter().fold([0.0; 3], |s, &w| add(s, p[w as usize])), 1.0 / nbrs[v].len() as f64);
+                let bary = scale(
+                    nbrs[v].iter().fold([0.0; 3], |s, &w| add(s, p[w as usize])),
+                    1.0 / nbrs[v].len() as f64,
+                );
                 if norm(sub(bary, p[v])) <= min_move {
                     parked.push(v);
                     continue;
@@ -258,7 +275,11 @@ fn flatten_to_star(
 /// Places the 4 vertices of a tetrahedron on a regular tetrahedron, positively oriented.
 fn embed_tetrahedron(map: &[u32], tris: &[[u32; 3]], sphere: &mut [Point3]) -> Result<()> {
     if map.len() != 4 || tris.len() != 4 {
-        return Err(Error::Internal(format!("tetrahedron expected, got {} vertices {} faces", map.len(), tris.len())));
+        return Err(Error::Internal(format!(
+            "tetrahedron expected, got {} vertices {} faces",
+            map.len(),
+            tris.len()
+        )));
     }
     let s = 1.0 / 3f64.sqrt();
     let mut corners = [[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]];
@@ -352,14 +373,34 @@ fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Po
             }
         }
     }
+    // Last resort: every direction around vs at shrinking distances (the valid wedge at vs can be
+    // narrow and lie across a thin fan triangle).
+    let mut eps = 0.25;
+    let e1 =
+        normalize(if ps[0].abs() < 0.9 { cross(ps, [1.0, 0.0, 0.0]) } else { cross(ps, [0.0, 1.0, 0.0]) });
+    let e2 = cross(ps, e1);
+    while best.is_none() && eps > 1e-13 {
+        for d in 0..256 {
+            let th = d as f64 * (2.0 * PI / 256.0);
+            consider(
+                &mut best,
+                normalize(add(ps, add(scale(e1, eps * th.cos()), scale(e2, eps * th.sin())))),
+            );
+        }
+        eps *= 0.25;
+    }
     let mut eps = 0.25;
     while best.is_none() && eps > 1e-12 {
         for &(a, b) in &pairs {
             if a == vs || b == vs {
                 continue;
             }
-            let m = add(sphere[a as usize], sphere[b as usize]);
-            consider(&mut best, normalize(add(scale(ps, 1.0 - eps), scale(m, eps / 2.0))));
+            // Several directions across the fan triangle: the valid wedge at vs may be narrow.
+            for w in 1..16 {
+                let w = w as f64 / 16.0;
+                let m = add(scale(sphere[a as usize], w), scale(sphere[b as usize], 1.0 - w));
+                consider(&mut best, normalize(add(scale(ps, 1.0 - eps), scale(m, eps))));
+            }
         }
         for &(a, b) in &pairs {
             let other = if a == vs {
@@ -376,9 +417,34 @@ fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Po
     match best {
         Some((_, x)) => {
             sphere[vt as usize] = x;
+            // The split shrank vs's star: let vs move to its ring's centroid if that improves its
+            // worst triangle (keeps 180° corners from building up).
+            improve_vertex(h, vs, sphere);
             Ok(())
         }
-        None => Err(Error::numerical("parameterise", format!("no valid position found to re-insert vertex {vt}"))),
+        None => {
+            Err(Error::numerical("parameterise", format!("no valid position found to re-insert vertex {vt}")))
+        }
+    }
+}
+
+/// Moves `v` to the normalised centroid of its ring when that is valid and raises the worst
+/// shape quality of its faces.
+fn improve_vertex(h: &Hierarchy, v: u32, sphere: &mut [Point3]) {
+    let pairs = ring_pairs(h, v);
+    let ring: Vec<(Point3, Point3, Point3)> = pairs
+        .iter()
+        .map(|&(a, b)| {
+            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+            (pa, pb, cross(pa, pb))
+        })
+        .collect();
+    let cur = star_quality(sphere[v as usize], &ring).unwrap_or(-1.0);
+    let c = normalize(ring.iter().fold([0.0; 3], |s, r| add(s, r.0)));
+    if let Some(q) = star_quality(c, &ring) {
+        if q > cur {
+            sphere[v as usize] = c;
+        }
     }
 }
 
@@ -402,7 +468,13 @@ fn mvc_target(h: &Hierarchy, v: u32, pos: &[Point3], sphere: &[Point3]) -> Point
 
 /// Gauss–Seidel sweeps moving each alive vertex towards its mean-value target, only by moves
 /// that keep every incident face positively oriented (halving the step up to 4 times).
-fn relax(h: &Hierarchy, pos: &[Point3], sphere: &mut [Point3], sweeps: usize, progress: &Progress) -> Result<()> {
+fn relax(
+    h: &Hierarchy,
+    pos: &[Point3],
+    sphere: &mut [Point3],
+    sweeps: usize,
+    progress: &Progress,
+) -> Result<()> {
     for _ in 0..sweeps {
         progress.check()?;
         for v in 0..h.vertex_alive.len() {

@@ -75,8 +75,13 @@ fn quadric_eval(q: &[f64; 10], v: Point3) -> f64 {
     s
 }
 
-#[derive(PartialEq, PartialOrd)]
+#[derive(PartialEq)]
 struct Cost(f64);
+impl PartialOrd for Cost {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
 impl Eq for Cost {}
 impl Ord for Cost {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {

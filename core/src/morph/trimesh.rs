@@ -279,7 +279,9 @@ pub fn require_sphere_like(info: &TopologyInfo, which: &str) -> Result<()> {
     if problems.is_empty() {
         match info.genus {
             Some(0) => return Ok(()),
-            Some(g) => problems.push(format!("closed surface of genus {g} (V−E+F = {})", info.euler_characteristic)),
+            Some(g) => {
+                problems.push(format!("closed surface of genus {g} (V−E+F = {})", info.euler_characteristic))
+            }
             None => problems.push(format!("Euler characteristic {}", info.euler_characteristic)),
         }
     }

@@ -24,8 +24,11 @@ impl Default for Similarity {
 }
 
 impl Similarity {
-    pub const IDENTITY: Similarity =
-        Similarity { rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], scale: 1.0, translation: [0.0; 3] };
+    pub const IDENTITY: Similarity = Similarity {
+        rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        scale: 1.0,
+        translation: [0.0; 3],
+    };
 
     pub fn apply(&self, p: Point3) -> Point3 {
         add(scale(mat_vec(&self.rotation, p), self.scale), self.translation)
@@ -80,7 +83,10 @@ pub fn symmetric_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
         v[i * n + i] = 1.0;
     }
     for _sweep in 0..64 {
-        let off: f64 = (0..n).flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j))).map(|(i, j)| a[i * n + j].powi(2)).sum();
+        let off: f64 = (0..n)
+            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i * n + j].powi(2))
+            .sum();
         let diag: f64 = (0..n).map(|i| a[i * n + i].powi(2)).sum();
         if off <= 1e-30 * diag.max(1e-300) {
             break;
@@ -186,7 +192,8 @@ pub fn pca_frame(pos: &[Point3], tris: &[[u32; 3]]) -> PcaFrame {
         let m = scale(add(add(p[0], p[1]), p[2]), 1.0 / 3.0);
         for k in 0..3 {
             // Mean of x³ over the triangle approximated by the average over corners and centroid.
-            let vals: f64 = p.iter().map(|q| dot(*q, axes[k]).powi(3)).sum::<f64>() + 3.0 * dot(m, axes[k]).powi(3);
+            let vals: f64 =
+                p.iter().map(|q| dot(*q, axes[k]).powi(3)).sum::<f64>() + 3.0 * dot(m, axes[k]).powi(3);
             skew[k] += ar * vals / 6.0;
         }
     }
@@ -197,7 +204,9 @@ pub fn pca_frame(pos: &[Point3], tris: &[[u32; 3]]) -> PcaFrame {
         }
     }
     if dot(cross(axes[0], axes[1]), axes[2]) < 0.0 {
-        let weakest = (0..3).min_by(|&i, &j| skew[i].partial_cmp(&skew[j]).unwrap_or(std::cmp::Ordering::Equal)).unwrap_or(2);
+        let weakest = (0..3)
+            .min_by(|&i, &j| skew[i].partial_cmp(&skew[j]).unwrap_or(std::cmp::Ordering::Equal))
+            .unwrap_or(2);
         axes[weakest] = scale(axes[weakest], -1.0);
         skew[weakest] = -skew[weakest];
     }
@@ -336,7 +345,9 @@ pub fn solve_dense(a: &[f64], b: &[f64], n: usize) -> Option<Vec<f64>> {
     let mut x = b.to_vec();
     let scale_ref = m.iter().fold(0.0f64, |s, v| s.max(v.abs())).max(1e-300);
     for col in 0..n {
-        let piv = (col..n).max_by(|&i, &j| m[i * n + col].abs().partial_cmp(&m[j * n + col].abs()).unwrap_or(std::cmp::Ordering::Equal))?;
+        let piv = (col..n).max_by(|&i, &j| {
+            m[i * n + col].abs().partial_cmp(&m[j * n + col].abs()).unwrap_or(std::cmp::Ordering::Equal)
+        })?;
         if m[piv * n + col].abs() <= 1e-14 * scale_ref {
             return None;
         }
@@ -385,11 +396,14 @@ mod tests {
 
     #[test]
     fn procrustes_recovers_known_similarity() {
-        let truth = Similarity { rotation: rot([1.0, 2.0, -0.5], 1.1), scale: 2.5, translation: [3.0, -1.0, 0.25] };
-        let src: Vec<Point3> = (0..30).map(|i| {
-            let t = i as f64;
-            [t.sin(), (1.3 * t).cos() * 2.0, (0.7 * t).sin() - 0.3]
-        }).collect();
+        let truth =
+            Similarity { rotation: rot([1.0, 2.0, -0.5], 1.1), scale: 2.5, translation: [3.0, -1.0, 0.25] };
+        let src: Vec<Point3> = (0..30)
+            .map(|i| {
+                let t = i as f64;
+                [t.sin(), (1.3 * t).cos() * 2.0, (0.7 * t).sin() - 0.3]
+            })
+            .collect();
         let dst: Vec<Point3> = src.iter().map(|&p| truth.apply(p)).collect();
         let est = procrustes(&src, &dst, true);
         assert!((est.scale - 2.5).abs() < 1e-10);
@@ -412,7 +426,8 @@ mod tests {
         }
         let tris = crate::shapes::fan_triangles(&m.faces);
         let f0 = pca_frame(&m.positions, &tris);
-        let moved = Similarity { rotation: rot([0.3, -1.0, 0.8], 2.3), scale: 0.2, translation: [10.0, 5.0, -7.0] };
+        let moved =
+            Similarity { rotation: rot([0.3, -1.0, 0.8], 2.3), scale: 0.2, translation: [10.0, 5.0, -7.0] };
         let p2: Vec<Point3> = m.positions.iter().map(|&p| moved.apply(p)).collect();
         let f1 = pca_frame(&p2, &tris);
         for (a, b) in m.positions.iter().zip(&p2) {
@@ -420,7 +435,10 @@ mod tests {
             let y = f1.to_normalised.apply(*b);
             assert!(norm(sub(x, y)) < 1e-9, "{x:?} vs {y:?}");
         }
-        let det = dot(cross(f0.to_normalised.rotation[0], f0.to_normalised.rotation[1]), f0.to_normalised.rotation[2]);
+        let det = dot(
+            cross(f0.to_normalised.rotation[0], f0.to_normalised.rotation[1]),
+            f0.to_normalised.rotation[2],
+        );
         assert!((det - 1.0).abs() < 1e-12);
     }
 
@@ -432,7 +450,8 @@ mod tests {
         }
         let tris = crate::shapes::fan_triangles(&m.faces);
         let idx = surface::SurfaceIndex::new(&m.positions, &tris);
-        let motion = Similarity { rotation: rot([0.2, 1.0, 0.1], 0.12), scale: 1.0, translation: [0.05, -0.04, 0.03] };
+        let motion =
+            Similarity { rotation: rot([0.2, 1.0, 0.1], 0.12), scale: 1.0, translation: [0.05, -0.04, 0.03] };
         let src: Vec<Point3> = m.positions.iter().map(|&p| motion.apply(p)).collect();
         let r = icp(&src, &idx, 100);
         assert!(r.rms_after < 1e-3 * r.rms_before.max(1e-3), "{r:?}");
