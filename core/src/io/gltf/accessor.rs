@@ -69,6 +69,15 @@ pub(super) struct Header {
     /// Components per element (1 for SCALAR … 4 for VEC4).
     pub width: usize,
     pub type_name: String,
+    layout: Option<Layout>,
+}
+
+/// Where an accessor's elements lie in its buffer view (already bounds-checked).
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    view: usize,
+    offset: usize,
+    stride: usize,
 }
 
 impl Header {
@@ -140,7 +149,7 @@ fn decode_data_uri(uri: &str, path: &str) -> Result<Vec<u8>> {
     if !header.ends_with(";base64") {
         return Err(bad(&p, "only base64 data: URIs are supported"));
     }
-    base64::decode(uri[comma + 1..].as_bytes())
+    base64::decode(&uri.as_bytes()[comma + 1..])
         .map_err(|at| bad(&p, format!("invalid base64 at character {at} of the data")))
 }
 
@@ -214,7 +223,39 @@ impl<'a> Store<'a> {
             return Err(bad(join(&path, "normalized"), format!("{} cannot be normalized", component.name())));
         }
         let count = usize::try_from(count).map_err(|_| bad(join(&path, "count"), "too large"))?;
-        Ok(Header { index: i, component, normalized, count, width, type_name: type_name.to_owned() })
+        let layout = self.layout(acc, &path, count, component.size() * width)?;
+        Ok(Header { index: i, component, normalized, count, width, type_name: type_name.to_owned(), layout })
+    }
+
+    /// Where the elements are, after checking (overflow-checked) that all `count` elements of
+    /// `elem` bytes lie inside the buffer view. `None`: no buffer view (all zeros).
+    fn layout(&self, acc: &Obj, path: &str, count: usize, elem: usize) -> Result<Option<Layout>> {
+        let Some(v) = index(acc, "bufferView", path, self.views.len(), "buffer view")? else {
+            return Ok(None);
+        };
+        let (bytes, stride) = self.view(v)?;
+        let stride = stride.unwrap_or(elem);
+        if stride < elem {
+            return Err(bad(
+                format!("bufferViews[{v}].byteStride"),
+                format!("{stride} is smaller than the {elem}-byte elements of {path}"),
+            ));
+        }
+        let offset = uint(acc, "byteOffset", path)?.unwrap_or(0);
+        let need = (count as u64 - 1)
+            .checked_mul(stride as u64)
+            .and_then(|x| x.checked_add(elem as u64))
+            .and_then(|x| x.checked_add(offset));
+        match need {
+            Some(need) if need <= bytes.len() as u64 => Ok(Some(Layout { view: v, offset: offset as usize, stride })),
+            _ => Err(bad(
+                path,
+                format!(
+                    "{count} elements of {elem} bytes (stride {stride}) from byte {offset} do not fit in bufferViews[{v}] ({} bytes)",
+                    bytes.len()
+                ),
+            )),
+        }
     }
 
     /// Decodes the elements of `h` as f64 (normalized integers mapped to [0, 1] or [-1, 1]),
@@ -282,42 +323,18 @@ impl<'a> Store<'a> {
     ) -> Result<Vec<T>> {
         let path = h.path();
         let acc = object(&self.accessors[h.index], &path)?;
-        let elem = h.component.size() * h.width;
         let total = h.count.checked_mul(h.width).ok_or_else(|| bad(join(&path, "count"), "too large"))?;
         let mut out: Vec<T>;
-        match index(acc, "bufferView", &path, self.views.len(), "buffer view")? {
-            Some(v) => {
-                let (bytes, stride) = self.view(v)?;
-                let stride = stride.unwrap_or(elem);
-                if stride < elem {
-                    return Err(bad(
-                        format!("bufferViews[{v}].byteStride"),
-                        format!("{stride} is smaller than the {elem}-byte elements of {path}"),
-                    ));
-                }
-                let offset = uint(acc, "byteOffset", &path)?.unwrap_or(0);
-                let need = (h.count as u64 - 1)
-                    .checked_mul(stride as u64)
-                    .and_then(|x| x.checked_add(elem as u64))
-                    .and_then(|x| x.checked_add(offset));
-                match need {
-                    Some(need) if need <= bytes.len() as u64 => {}
-                    _ => {
-                        return Err(bad(
-                            &path,
-                            format!(
-                                "{} elements of {elem} bytes (stride {stride}) from byte {offset} do not fit in bufferViews[{v}] ({} bytes)",
-                                h.count,
-                                bytes.len()
-                            ),
-                        ))
-                    }
-                }
-                // Fits: the allocation is bounded by the data actually present.
+        match h.layout {
+            Some(Layout { view, offset, stride }) => {
+                // header() checked that every element lies inside the view: the allocation is
+                // bounded by the data actually present.
+                let (bytes, _) = self.view(view)?;
+                let elem = h.component.size() * h.width;
                 out = Vec::with_capacity(total);
                 let cs = h.component.size();
                 for e in 0..h.count {
-                    let start = offset as usize + e * stride;
+                    let start = offset + e * stride;
                     let el = &bytes[start..start + elem];
                     for c in 0..h.width {
                         out.push(read(&el[c * cs..(c + 1) * cs]));

@@ -64,7 +64,7 @@ pub struct GltfBuilder {
 }
 
 fn pad_to_4(bytes: &mut Vec<u8>, fill: u8) {
-    while bytes.len() % 4 != 0 {
+    while !bytes.len().is_multiple_of(4) {
         bytes.push(fill);
     }
 }
@@ -134,7 +134,7 @@ impl GltfBuilder {
                 )))
             }
         };
-        if values.is_empty() || values.len() % width != 0 {
+        if values.is_empty() || !values.len().is_multiple_of(width) {
             return Err(Error::Internal(format!(
                 "accessor of {} floats cannot hold {type_name} elements (glTF needs count ≥ 1)",
                 values.len()

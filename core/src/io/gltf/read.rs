@@ -82,6 +82,9 @@ struct Prim<'a> {
     texcoord: Option<usize>,
 }
 
+/// Identifies a vertex block: world matrix (bit pattern), POSITION, NORMAL, TEXCOORD_0 accessors.
+type BlockKey = ([u64; 16], usize, Option<usize>, Option<usize>);
+
 /// Where a decoded vertex block sits in the output.
 #[derive(Clone, Copy)]
 struct Block {
@@ -225,9 +228,8 @@ impl<'a> Reader<'a> {
         // Pass 1 (JSON only): which primitives, and do they all have normals / texcoords?
         let mut per_mesh: HashMap<usize, Vec<Prim<'a>>> = HashMap::new();
         for inst in instances {
-            if !per_mesh.contains_key(&inst.mesh) {
-                let prims = self.primitives(inst.mesh)?;
-                per_mesh.insert(inst.mesh, prims);
+            if let std::collections::hash_map::Entry::Vacant(e) = per_mesh.entry(inst.mesh) {
+                e.insert(self.primitives(inst.mesh)?);
             }
         }
         let all_prims = || instances.iter().flat_map(|i| per_mesh[&i.mesh].iter());
@@ -253,7 +255,7 @@ impl<'a> Reader<'a> {
 
         // Pass 2: decode and merge.
         let mut out = Out::new(keep_normals, keep_uvs);
-        let mut blocks: HashMap<([u64; 16], usize, Option<usize>, Option<usize>), Block> = HashMap::new();
+        let mut blocks: HashMap<BlockKey, Block> = HashMap::new();
         for inst in instances {
             let prims = &per_mesh[&inst.mesh];
             let mesh_name = self.mesh_name(inst)?;
@@ -421,14 +423,14 @@ impl<'a> Reader<'a> {
             match prim.mode {
                 4 => [idx[3 * k], idx[3 * k + 1], idx[3 * k + 2]],
                 // Strips alternate winding: odd triangles swap their last two vertices (spec 3.7.2.1).
-                5 if k % 2 == 0 => [idx[k], idx[k + 1], idx[k + 2]],
+                5 if k.is_multiple_of(2) => [idx[k], idx[k + 1], idx[k + 2]],
                 5 => [idx[k], idx[k + 2], idx[k + 1]],
                 _ => [idx[k + 1], idx[k + 2], idx[0]],
             }
         };
         let count = match prim.mode {
             4 => {
-                if n % 3 != 0 {
+                if !n.is_multiple_of(3) {
                     self.warnings.push(format!(
                         "{}: {} trailing indices (not a whole triangle) ignored",
                         prim.path,
@@ -464,7 +466,7 @@ impl<'a> Reader<'a> {
         let shifted = idx.iter().map(|&i| i + base);
         match prim.mode {
             1 => {
-                if idx.len() % 2 == 1 {
+                if !idx.len().is_multiple_of(2) {
                     self.warnings.push(format!("{}: odd index count, last LINES index ignored", prim.path));
                 }
                 // Consecutive segments that share an end point are joined into one polyline.
