@@ -2,10 +2,11 @@
 //! every malformed input becomes an [`Error`] saying what and where, never a panic. Declared counts
 //! in headers are never trusted for allocation: readers grow as data actually arrives.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Location, Result};
 use crate::mesh::Mesh;
 
 pub mod gltf;
+mod lex;
 pub mod obj;
 pub mod off;
 pub mod ply;
@@ -103,7 +104,11 @@ pub struct Loaded {
 
 /// Reads a mesh from bytes, detecting the format from the content.
 pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
-    match detect(bytes, opts.name_hint.as_deref())? {
+    let format = detect(bytes, opts.name_hint.as_deref())?;
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(Error::malformed(format_name(format), Location::Byte(0), "empty file"));
+    }
+    match format {
         Format::Obj => obj::read(bytes, opts),
         Format::Gltf | Format::Glb => gltf::read(bytes, opts),
         Format::Ply => ply::read(bytes, opts),
@@ -112,13 +117,64 @@ pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
     }
 }
 
-/// The format of `bytes`, from magic numbers and content; `name_hint` only breaks ties.
-pub fn detect(bytes: &[u8], name_hint: Option<&str>) -> Result<Format> {
-    if bytes.starts_with(b"glTF") {
-        return Ok(Format::Glb);
+/// The name used in [`Error::Malformed`] for a format.
+pub(crate) fn format_name(f: Format) -> &'static str {
+    match f {
+        Format::Obj => "obj",
+        Format::Gltf => "gltf",
+        Format::Glb => "glb",
+        Format::Ply => "ply",
+        Format::Stl => "stl",
+        Format::Off => "off",
     }
-    let _ = name_hint;
-    Err(Error::UnsupportedFormat("format detection not implemented yet".into()))
+}
+
+/// The format of `bytes`, from magic numbers and content; `name_hint` only decides when the
+/// content matches no format (e.g. an empty or truncated file).
+///
+/// Order matters: GLB magic; binary STL by its exact size (84 + 50·n bytes; binary files often
+/// start with "solid" too, so that prefix proves nothing); PLY magic; JSON with an `"asset"` key
+/// (glTF); an OFF header; ASCII STL (`solid` then `facet`/`endsolid`); OBJ statements.
+pub fn detect(bytes: &[u8], name_hint: Option<&str>) -> Result<Format> {
+    if let Some(f) = detect_content(bytes) {
+        return Ok(f);
+    }
+    if let Some(f) = name_hint.and_then(Format::from_name) {
+        return Ok(f);
+    }
+    if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        return Err(Error::malformed("mesh", Location::Byte(0), "empty file"));
+    }
+    Err(Error::UnsupportedFormat(
+        "content matches none of OBJ, glTF/GLB, PLY, STL, OFF (no magic number or known statements)".into(),
+    ))
+}
+
+fn detect_content(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(b"glTF") {
+        return Some(Format::Glb);
+    }
+    if stl::is_binary_size(bytes) && !stl::looks_ascii(bytes) {
+        return Some(Format::Stl);
+    }
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let text = &text[text.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(text.len())..];
+    if text.starts_with(b"ply\n") || text.starts_with(b"ply\r\n") {
+        return Some(Format::Ply);
+    }
+    if text.starts_with(b"{") && memchr::memmem::find(text, b"\"asset\"").is_some() {
+        return Some(Format::Gltf);
+    }
+    if off::looks_like_off(text) {
+        return Some(Format::Off);
+    }
+    if stl::looks_ascii(text) {
+        return Some(Format::Stl);
+    }
+    if obj::looks_like_obj(text) {
+        return Some(Format::Obj);
+    }
+    None
 }
 
 /// Writes a mesh in the given format.
