@@ -152,7 +152,7 @@ fn job_headers(h: &mut HeaderMap, id: &str) {
 pub async fn submit_sync(State(st): State<Shared>, Path(job): Path<String>, req: Request) -> Response {
     match sync_inner(st, job, req).await {
         Ok(r) => r,
-        Err(p) => p.into_response(),
+        Err(p) => refused(p),
     }
 }
 
@@ -178,6 +178,17 @@ async fn sync_inner(st: Shared, job: String, req: Request) -> Result<Response, P
     };
     job_headers(resp.headers_mut(), &id);
     Ok(resp)
+}
+
+/// An error response to a submission. One refused before its job started (no `job_id`) may leave
+/// the request body unread, so the connection is closed rather than reused mid-body.
+fn refused(p: Problem) -> Response {
+    let early = !p.extra.contains_key("job_id");
+    let mut r = p.into_response();
+    if early {
+        r.headers_mut().insert(header::CONNECTION, HeaderValue::from_static("close"));
+    }
+    r
 }
 
 fn file_response(f: ResultFile, name: &str) -> Response {
@@ -217,7 +228,7 @@ fn multipart_mixed(report: &Value, f: &ResultFile, name: &str) -> Response {
 pub async fn submit_async(State(st): State<Shared>, req: Request) -> Response {
     match async_inner(st, req).await {
         Ok(r) => r,
-        Err(p) => p.into_response(),
+        Err(p) => refused(p),
     }
 }
 

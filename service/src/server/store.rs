@@ -90,6 +90,7 @@ pub struct Store {
     ttl: Duration,
     max_bytes: usize,
     max_jobs: usize,
+    tombstone_min: Duration,
 }
 
 struct Inner {
@@ -123,6 +124,7 @@ impl Store {
             ttl,
             max_bytes,
             max_jobs: max_jobs.max(1),
+            tombstone_min: Duration::from_secs(600),
         }
     }
 
@@ -200,16 +202,18 @@ impl Store {
         }
     }
 
-    /// Expires results older than the TTL, and forgets records older than twice the TTL.
+    /// Expires results older than the TTL, and forgets records once the TTL has passed a second
+    /// time (at least 10 minutes) so that clients can still learn why a result is gone.
     /// `finished` is in finish order, so ages only decrease along it.
     pub fn sweep(&self) {
         let mut g = self.lock();
         let inner = &mut *g;
         let now = Instant::now();
         let age = |r: &Record| r.finished.map_or(Duration::ZERO, |(_, t)| now.saturating_duration_since(t));
+        let forget_after = self.ttl + self.ttl.max(self.tombstone_min);
         while let Some(id) = inner.finished.front() {
             match inner.map.get(id) {
-                Some(r) if age(r) < self.ttl * 2 => break,
+                Some(r) if age(r) < forget_after => break,
                 Some(_) => {
                     if let Some(r) = inner.map.remove(id) {
                         inner.bytes -= r.bytes;
@@ -373,7 +377,8 @@ mod tests {
 
     #[test]
     fn ttl_expires_then_forgets() {
-        let s = Store::new(Duration::from_millis(30), 1 << 20, 100);
+        let mut s = Store::new(Duration::from_millis(30), 1 << 20, 100);
+        s.tombstone_min = Duration::ZERO;
         let a = s.insert("convert", Progress::new());
         s.finish(&a, Ok((Some(file(10)), serde_json::json!({"x": 1}))));
         std::thread::sleep(Duration::from_millis(40));
