@@ -1,1 +1,0 @@
-//! Discrete Laplace operators and mass matrices (uniform, cotangent, hybrid quad/triangle, boundary).
