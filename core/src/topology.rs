@@ -461,8 +461,9 @@ impl Topology {
             .collect()
     }
 
-    /// For an edge with exactly two uses, the use other than `corner` (global corner id).
-    fn other_use(&self, e: u32, corner: usize) -> Option<EdgeUse> {
+    /// For an edge with exactly two uses, the use other than the half-edge at global corner
+    /// `corner` (None on boundary and non-manifold edges).
+    pub fn other_use(&self, e: u32, corner: usize) -> Option<EdgeUse> {
         let u = self.edge_uses(e);
         if u.len() != 2 {
             return None;
@@ -479,7 +480,7 @@ impl Topology {
     /// The corner at vertex `v` of the half-edge starting at global corner `c` (`c` itself or
     /// the next corner).
     #[inline]
-    fn corner_at(&self, c: usize, v: u32) -> usize {
+    pub fn corner_at(&self, c: usize, v: u32) -> usize {
         if self.corner_vertex[c] == v {
             c
         } else {

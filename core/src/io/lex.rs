@@ -14,6 +14,7 @@ pub fn is_space(b: u8) -> bool {
 }
 
 /// Splits a line into whitespace-separated tokens.
+#[derive(Clone)]
 pub struct Tokens<'a> {
     rest: &'a [u8],
 }
@@ -152,7 +153,6 @@ pub fn parse_i64(tok: &[u8]) -> Option<i64> {
 
 /// Parses an unsigned decimal count.
 #[inline]
-#[allow(dead_code)] // used by the PLY/OFF readers
 pub fn parse_u64(tok: &[u8]) -> Option<u64> {
     match parse_i64(tok)? {
         v if v >= 0 && tok.first() != Some(&b'-') => Some(v as u64),

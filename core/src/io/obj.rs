@@ -196,6 +196,9 @@ fn parse_line(c: &mut Chunk, line: &[u8], n: usize) -> Result<()> {
             Ok(())
         }
         other => {
+            if let Some(&b) = other.iter().find(|&&b| b < 0x20 || b == 0x7f) {
+                return Err(malformed(n, format!("binary data (byte 0x{b:02x}) in a text file")));
+            }
             count_ignored(c, other);
             Ok(())
         }

@@ -1,16 +1,27 @@
-//! STL reading and writing.
+//! STL reading (ascii and binary) and writing (binary).
+//!
+//! Binary is recognised by its exact size, 84 + 50·n bytes with n the header's triangle count, and
+//! not by a "solid" prefix (binary headers often start with "solid" too). STL stores every
+//! triangle's corners separately; reading welds exactly coincident positions (−0 = +0) so that
+//! the mesh has connectivity, and says how many corners were merged.
 
-use super::{Loaded, ReadOptions};
-use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+use super::lex::{self, Tokens};
+use super::{Format, Loaded, ReadOptions};
+use crate::error::{Error, Location, Result};
+use crate::geometry;
+use crate::mesh::{Faces, Mesh};
 
 /// True when the length is exactly that of a binary STL with the triangle count in its header.
 pub(crate) fn is_binary_size(bytes: &[u8]) -> bool {
-    if bytes.len() < 84 {
-        return false;
-    }
-    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-    84 + 50 * n == bytes.len() as u64
+    binary_count(bytes).is_some_and(|n| 84 + 50 * n == bytes.len() as u64)
+}
+
+fn binary_count(bytes: &[u8]) -> Option<u64> {
+    let c = bytes.get(80..84)?;
+    Some(u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as u64)
 }
 
 /// True for text that starts with `solid` and has a `facet` or `endsolid` in its first kilobyte,
@@ -26,11 +37,214 @@ pub(crate) fn looks_ascii(bytes: &[u8]) -> bool {
 }
 
 /// Decodes STL bytes.
-pub fn read(_bytes: &[u8], _opts: &ReadOptions) -> Result<Loaded> {
-    Err(Error::UnsupportedFormat("reading STL not implemented yet".into()))
+pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
+    let ascii = if is_binary_size(bytes) { looks_ascii(bytes) } else { starts_with_solid(bytes) };
+    let (soup, groups) =
+        if ascii { read_ascii(bytes, opts)? } else { (read_binary(bytes, opts)?, Vec::new()) };
+    Ok(weld(soup, groups))
 }
 
-/// Encodes `mesh` (binary; polygons fan-triangulated).
-pub fn write(_mesh: &Mesh) -> Result<Vec<u8>> {
-    Err(Error::UnsupportedFormat("writing STL not implemented yet".into()))
+fn starts_with_solid(bytes: &[u8]) -> bool {
+    let t = lex::trim(&bytes[..bytes.len().min(64)]);
+    t.len() >= 5 && t[..5].eq_ignore_ascii_case(b"solid")
+}
+
+/// Triangles (or polygons, in ascii) with their own corners, before welding.
+#[derive(Default)]
+struct Soup {
+    corners: Vec<[f64; 3]>,
+    /// Corners per facet (3 for binary).
+    arity: Vec<u32>,
+    groups: Vec<u32>,
+}
+
+fn read_binary(bytes: &[u8], opts: &ReadOptions) -> Result<Soup> {
+    let Some(n) = binary_count(bytes) else {
+        return Err(Error::malformed(
+            "stl",
+            Location::Byte(bytes.len()),
+            format!("{} bytes: too short for a binary STL header (84 bytes) and not ascii STL", bytes.len()),
+        ));
+    };
+    if n > opts.max_faces as u64 {
+        return Err(Error::TooLarge { what: "faces".into(), limit: opts.max_faces as u64, actual: n });
+    }
+    let need = 84 + 50 * n;
+    if need != bytes.len() as u64 {
+        return Err(Error::malformed(
+            "stl",
+            Location::Byte(80),
+            format!("header declares {n} triangles = {need} bytes, the file has {} bytes", bytes.len()),
+        ));
+    }
+    let n = n as usize; // the size check above bounds n by the file length
+    let mut soup = Soup { corners: Vec::with_capacity(3 * n), arity: vec![3; n], groups: vec![0; n] };
+    for (t, rec) in bytes[84..].chunks_exact(50).enumerate() {
+        for k in 0..3 {
+            let at = 12 + 12 * k;
+            let mut p = [0.0; 3];
+            for (c, v) in p.iter_mut().enumerate() {
+                let o = at + 4 * c;
+                *v = f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]) as f64;
+            }
+            if !p.iter().all(|c| c.is_finite()) {
+                return Err(Error::InvalidMesh {
+                    location: Location::Byte(84 + 50 * t + at),
+                    message: format!("triangle {t}: coordinate is NaN or infinite"),
+                });
+            }
+            soup.corners.push(p);
+        }
+    }
+    Ok(soup)
+}
+
+fn ascii_err(line: usize, msg: impl Into<String>) -> Error {
+    Error::malformed("stl", Location::Line(line), msg)
+}
+
+/// Ascii STL, line by line: `solid name`, then per facet `facet normal …`, `outer loop`, ≥ 3
+/// `vertex x y z`, `endloop`, `endfacet`; `endsolid`. Several solids become named groups.
+fn read_ascii(bytes: &[u8], opts: &ReadOptions) -> Result<(Soup, Vec<String>)> {
+    let mut soup = Soup::default();
+    let mut groups: Vec<String> = Vec::new();
+    let mut in_facet = 0usize; // corners seen in the current facet, +1 once `facet` is open
+    let mut in_solid = false;
+    let mut last = 0;
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let n = i + 1;
+        last = n;
+        let mut t = Tokens::new(line);
+        match t.next() {
+            None => {}
+            Some(b"solid") if !in_solid => {
+                in_solid = true;
+                groups.push(String::from_utf8_lossy(t.rest()).into_owned());
+            }
+            Some(b"endsolid") if in_solid && in_facet == 0 => in_solid = false,
+            Some(b"facet") if in_solid && in_facet == 0 => in_facet = 1,
+            Some(b"outer" | b"endloop") if in_facet > 0 => {}
+            Some(b"vertex") if in_facet > 0 => {
+                let mut p = [0.0; 3];
+                for c in &mut p {
+                    let tok = t.next().ok_or_else(|| ascii_err(n, "`vertex` needs 3 numbers"))?;
+                    *c = lex::parse_f64(tok).ok_or_else(|| {
+                        ascii_err(n, format!("`{}` is not a number", String::from_utf8_lossy(tok)))
+                    })?;
+                }
+                if !p.iter().all(|c| c.is_finite()) {
+                    return Err(Error::InvalidMesh {
+                        location: Location::Line(n),
+                        message: "coordinate is NaN or infinite".into(),
+                    });
+                }
+                soup.corners.push(p);
+                in_facet += 1;
+            }
+            Some(b"endfacet") if in_facet > 0 => {
+                let k = in_facet - 1;
+                if k < 3 {
+                    return Err(ascii_err(n, format!("facet has {k} vertices, at least 3 are needed")));
+                }
+                soup.arity.push(k as u32);
+                soup.groups.push(groups.len().saturating_sub(1) as u32);
+                if soup.arity.len() > opts.max_faces {
+                    let (limit, actual) = (opts.max_faces as u64, soup.arity.len() as u64);
+                    return Err(Error::TooLarge { what: "faces".into(), limit, actual });
+                }
+                in_facet = 0;
+            }
+            Some(other) => {
+                let s = String::from_utf8_lossy(other);
+                return Err(ascii_err(n, format!("unexpected `{s}`")));
+            }
+        }
+    }
+    if in_facet > 0 || in_solid {
+        return Err(ascii_err(last, "file ends inside a facet or solid (truncated?)"));
+    }
+    if soup.arity.is_empty() {
+        return Err(ascii_err(last, "no facets"));
+    }
+    Ok((soup, groups))
+}
+
+/// A fast hasher for exact coordinate bit patterns (SipHash is needlessly slow here, and the
+/// keys are not attacker-chosen in a way that matters: worst case is a slow weld, not a crash).
+#[derive(Default)]
+struct BitsHasher(u64);
+
+impl Hasher for BitsHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+/// Merges exactly coincident corners into shared vertices (first occurrence order).
+fn weld(soup: Soup, groups: Vec<String>) -> Loaded {
+    let mut map: HashMap<[u64; 3], u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
+    map.reserve(soup.corners.len() / 2);
+    let mut positions = Vec::with_capacity(soup.corners.len() / 2);
+    let mut index = Vec::with_capacity(soup.corners.len());
+    for p in &soup.corners {
+        let key = p.map(|c| (c + 0.0).to_bits()); // -0.0 + 0.0 = +0.0
+        let id = *map.entry(key).or_insert_with(|| {
+            positions.push(*p);
+            (positions.len() - 1) as u32
+        });
+        index.push(id);
+    }
+    let mut faces = Faces::with_capacity(soup.arity.len(), index.len());
+    let mut start = 0;
+    for (&k, &g) in soup.arity.iter().zip(&soup.groups) {
+        faces.push(&index[start..start + k as usize], g);
+        start += k as usize;
+    }
+    let warnings = vec![format!(
+        "welded {} facet corners into {} vertices (exactly coincident positions)",
+        soup.corners.len(),
+        positions.len()
+    )];
+    let groups = if groups.len() > 1 { groups } else { Vec::new() };
+    Loaded { mesh: Mesh { positions, faces, groups, ..Default::default() }, format: Format::Stl, warnings }
+}
+
+/// Encodes `mesh` as binary STL: polygons are fan-triangulated (STL holds only triangles),
+/// coordinates become f32, normals are computed per triangle, groups and curves are not kept.
+pub fn write(mesh: &Mesh) -> Result<Vec<u8>> {
+    mesh.check()?;
+    let ntri: usize = (0..mesh.faces.len()).map(|i| mesh.faces.arity(i).saturating_sub(2)).sum();
+    let ntri32 = u32::try_from(ntri).map_err(|_| Error::TooLarge {
+        what: "STL triangles".into(),
+        limit: u32::MAX as u64,
+        actual: ntri as u64,
+    })?;
+    let mut out = Vec::with_capacity(84 + 50 * ntri);
+    // The header must not start with "solid" (some readers take that as ascii).
+    let mut header = [b' '; 80];
+    let text = b"binary STL written by meshwork; polygons fan-triangulated";
+    header[..text.len()].copy_from_slice(text);
+    out.extend_from_slice(&header);
+    out.extend_from_slice(&ntri32.to_le_bytes());
+    for f in mesh.faces.iter() {
+        for k in 1..f.len().saturating_sub(1) {
+            let tri = [f[0], f[k], f[k + 1]].map(|i| mesh.positions[i as usize]);
+            let n = geometry::normalize(geometry::triangle_cross(tri[0], tri[1], tri[2]));
+            for v in std::iter::once(n).chain(tri) {
+                for c in v {
+                    out.extend_from_slice(&(c as f32).to_le_bytes());
+                }
+            }
+            out.extend_from_slice(&[0, 0]);
+        }
+    }
+    Ok(out)
 }

@@ -1,0 +1,329 @@
+//! Repair of damaged meshes (seed 003 §4.2): weld, drop degenerate/duplicate faces, resolve
+//! non-manifold parts, orient, remove small components, fill holes, drop unreferenced vertices.
+//!
+//! Each step is optional, runs in the order below and reports what it changed, so a user can see
+//! exactly what happened to their data; nothing is removed without being counted.
+//!
+//! 1. [`weld`]: merge vertices closer than `weld_tolerance` × bbox diagonal (spatial hashing).
+//! 2. [`clean`]: collapse repeated consecutive indices, drop faces with < 3 distinct vertices or
+//!    zero area, drop faces with the same vertex set as an earlier face.
+//! 3. [`nonmanifold`]: split (duplicate vertices per fan, one face pair kept glued per edge) or
+//!    remove (drop the faces) at non-manifold edges and vertices.
+//! 4. [`orient`]: make orientation consistent by BFS over manifold edges.
+//! 5. [`components`]: drop components below `min_component_faces`, or all but the largest.
+//! 6. [`holes`]: fill boundary loops (Liepa minimum dihedral/area DP, centroid fan above
+//!    `dp_max_edges`), optionally refine and fair the patch.
+//! 7. [`orient::outward`]: flip closed components with negative signed volume.
+//! 8. [`clean::compact`]: drop unreferenced vertices and renumber (old → new map kept).
+
+pub mod clean;
+pub mod components;
+pub mod fair;
+pub mod holes;
+pub mod nonmanifold;
+pub mod orient;
+pub mod weld;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::job::{Output, Progress, Stages};
+use crate::mesh::{Mesh, Point3};
+use crate::topology::NONE;
+use crate::validate;
+
+/// What to do at non-manifold edges and vertices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum NonManifoldMode {
+    /// Duplicate vertices so each fan gets its own copy; at an edge with > 2 faces the best
+    /// matching pair (opposite winding, most nearly coplanar) stays glued, the others come loose.
+    Split,
+    /// Delete the faces on non-manifold edges and all fans but the largest at non-manifold
+    /// vertices (leaves holes, which hole filling can close).
+    Remove,
+    /// Leave them as they are.
+    Keep,
+}
+
+/// Parameters of the `repair` job. Every step can be switched off.
+#[derive(Debug, Clone, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct RepairParams {
+    /// Merge vertices closer than `weld_tolerance` × bounding-box diagonal.
+    pub weld: bool,
+    /// Weld distance relative to the bounding-box diagonal (default 1e-6). 0 merges only exactly
+    /// coincident positions.
+    pub weld_tolerance: f64,
+    /// Drop faces with < 3 distinct vertices or zero area (repeated consecutive indices in larger
+    /// faces are collapsed first).
+    pub remove_degenerate: bool,
+    /// Drop faces with the same vertex set as an earlier face (winding ignored).
+    pub remove_duplicates: bool,
+    pub non_manifold: NonManifoldMode,
+    /// Make face orientation consistent across manifold edges.
+    pub orient: bool,
+    /// Flip closed components whose signed volume is negative (needs `orient`).
+    pub outward: bool,
+    /// Drop connected components (by shared edges) with fewer faces than this (0: keep all).
+    pub min_component_faces: usize,
+    /// Keep only the component with most faces.
+    pub keep_largest: bool,
+    pub fill_holes: bool,
+    /// Holes with more boundary edges than this are left open (and reported).
+    pub max_hole_edges: usize,
+    /// Holes whose patch area would exceed this fraction of their component's area are left
+    /// open (an open sheet's rim is not a hole).
+    pub max_hole_area_ratio: f64,
+    /// Loops up to this many edges are triangulated by the minimum dihedral/area DP (O(n³));
+    /// longer ones get a centroid fan.
+    pub dp_max_edges: usize,
+    /// Split patch triangles until edge lengths match the surrounding mesh (Liepa).
+    pub refine: bool,
+    /// Move new interior vertices to the harmonic (membrane) position, boundary fixed.
+    pub fair: bool,
+    /// Drop vertices no face or curve uses, renumbering the rest.
+    pub remove_unreferenced: bool,
+    /// Fail (unsupported-topology error) instead of returning a mesh that is not manifold.
+    pub require_manifold: bool,
+    /// Include the full old → new vertex index map in the report (can be large).
+    pub report_vertex_map: bool,
+}
+
+impl Default for RepairParams {
+    fn default() -> Self {
+        RepairParams {
+            weld: true,
+            weld_tolerance: 1e-6,
+            remove_degenerate: true,
+            remove_duplicates: true,
+            non_manifold: NonManifoldMode::Split,
+            orient: true,
+            outward: true,
+            min_component_faces: 0,
+            keep_largest: false,
+            fill_holes: true,
+            max_hole_edges: 1000,
+            max_hole_area_ratio: 0.5,
+            dp_max_edges: 200,
+            refine: true,
+            fair: true,
+            remove_unreferenced: true,
+            require_manifold: false,
+            report_vertex_map: false,
+        }
+    }
+}
+
+impl RepairParams {
+    fn check(&self) -> Result<()> {
+        if !(self.weld_tolerance >= 0.0 && self.weld_tolerance.is_finite()) {
+            return Err(Error::params("weld_tolerance", "must be a finite number ≥ 0"));
+        }
+        if self.weld_tolerance > 0.1 {
+            return Err(Error::params(
+                "weld_tolerance",
+                "is relative to the bbox diagonal; > 0.1 would merge whole features",
+            ));
+        }
+        if !(self.max_hole_area_ratio > 0.0) {
+            return Err(Error::params("max_hole_area_ratio", "must be > 0"));
+        }
+        if self.dp_max_edges > 2000 {
+            return Err(Error::params("dp_max_edges", "the DP is O(n³); at most 2000"));
+        }
+        Ok(())
+    }
+}
+
+/// Tracks input vertex → current vertex through the steps.
+#[derive(Debug, Clone)]
+pub struct VertexMap {
+    /// `map[i]` = current index of input vertex `i`, [`NONE`] when removed.
+    pub map: Vec<u32>,
+}
+
+impl VertexMap {
+    pub fn identity(n: usize) -> Self {
+        VertexMap { map: (0..n as u32).collect() }
+    }
+
+    /// Composes with a step's map from current to new indices.
+    pub fn then(&mut self, step: &[u32]) {
+        for m in &mut self.map {
+            if *m != NONE {
+                *m = step[*m as usize];
+            }
+        }
+    }
+}
+
+/// Appends a vertex at `p`, giving it the mean normal/UV of `like` when the mesh has those.
+pub(crate) fn push_vertex(mesh: &mut Mesh, p: Point3, like: &[u32]) -> u32 {
+    let id = mesh.positions.len() as u32;
+    mesh.positions.push(p);
+    if let Some(nr) = &mut mesh.normals {
+        let mut s = [0.0; 3];
+        for &v in like {
+            s = crate::geometry::add(s, nr[v as usize]);
+        }
+        nr.push(crate::geometry::normalize(s));
+    }
+    if let Some(uv) = &mut mesh.uvs {
+        let mut s = [0.0; 2];
+        for &v in like {
+            s[0] += uv[v as usize][0];
+            s[1] += uv[v as usize][1];
+        }
+        let k = like.len().max(1) as f64;
+        uv.push([s[0] / k, s[1] / k]);
+    }
+    id
+}
+
+/// The `repair` job.
+pub fn run(mut mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Output> {
+    params.check()?;
+    mesh.check()?;
+    let mut stages = Stages::new();
+    let input = stages.run(progress, "validate_input", || Ok(validate::analyze(&mesh)))?;
+    let mut vmap = VertexMap::identity(mesh.positions.len());
+    let mut steps = serde_json::Map::new();
+    let diag = input.bbox_diagonal;
+
+    if params.weld {
+        let r =
+            stages.run(progress, "weld", || weld::weld(&mut mesh, params.weld_tolerance * diag, progress))?;
+        steps.insert("weld".into(), to_json(&r));
+    }
+    if params.remove_degenerate || params.remove_duplicates {
+        let r = stages.run(progress, "clean", || {
+            Ok(clean::clean(&mut mesh, params.remove_degenerate, params.remove_duplicates, diag))
+        })?;
+        steps.insert("clean".into(), to_json(&r));
+    }
+    if params.non_manifold != NonManifoldMode::Keep {
+        let r = stages.run(progress, "non_manifold", || {
+            nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
+        })?;
+        steps.insert("non_manifold".into(), to_json(&r));
+    }
+    if params.orient {
+        let r = stages.run(progress, "orient", || Ok(orient::make_consistent(&mut mesh)))?;
+        steps.insert("orient".into(), to_json(&r));
+    }
+    if params.min_component_faces > 0 || params.keep_largest {
+        let r = stages.run(progress, "components", || {
+            Ok(components::remove_small(&mut mesh, params.min_component_faces, params.keep_largest))
+        })?;
+        steps.insert("components".into(), to_json(&r));
+    }
+    let mut holes_report = None;
+    if params.fill_holes {
+        let r = stages.run(progress, "fill_holes", || {
+            holes::fill(&mut mesh, &holes::FillOptions::from(params), progress)
+        })?;
+        steps.insert("fill_holes".into(), to_json(&r));
+        holes_report = Some(r);
+    }
+    if params.orient && params.outward {
+        let r = stages.run(progress, "outward", || Ok(orient::outward(&mut mesh)))?;
+        steps.insert("outward".into(), to_json(&r));
+    }
+    if params.remove_unreferenced {
+        let r = stages.run(progress, "compact", || Ok(clean::compact(&mut mesh)))?;
+        vmap.then(&r.map);
+        steps.insert("unreferenced".into(), to_json(&r));
+    }
+
+    let out = stages.run(progress, "validate_output", || Ok(validate::analyze(&mesh)))?;
+    let why = why_not(&out, holes_report.as_ref(), params);
+    if params.require_manifold && !(out.manifold && out.pinch_vertices == 0) {
+        return Err(Error::Topology(format!("repaired mesh is not manifold: {}", why.join("; "))));
+    }
+    let kept = vmap.map.iter().filter(|&&m| m != NONE).count();
+    let mut report = serde_json::json!({
+        "input": summary(&input),
+        "output": summary(&out),
+        "steps": steps,
+        "manifold": out.manifold && out.pinch_vertices == 0,
+        "closed": out.closed,
+        "why_not": why,
+        "vertex_map": {
+            "input_vertices": vmap.map.len(),
+            "kept": kept,
+            "removed": vmap.map.len() - kept,
+            "output_vertices": mesh.positions.len(),
+        },
+        "stages": stages.to_json(),
+        "total_ms": stages.total_ms(),
+    });
+    if params.report_vertex_map {
+        report["vertex_map"]["map"] = serde_json::json!(vmap
+            .map
+            .iter()
+            .map(|&m| if m == NONE { -1 } else { m as i64 })
+            .collect::<Vec<_>>());
+    }
+    Ok(Output { meshes: vec![mesh], report, ..Default::default() })
+}
+
+/// Reasons the output is not a closed manifold, in words.
+fn why_not(out: &validate::Report, holes: Option<&holes::FillReport>, params: &RepairParams) -> Vec<String> {
+    let mut why = Vec::new();
+    if out.non_manifold_edges > 0 {
+        why.push(format!(
+            "{} non-manifold edges (non_manifold = {:?})",
+            out.non_manifold_edges, params.non_manifold
+        ));
+    }
+    if out.non_manifold_vertices > 0 {
+        why.push(format!(
+            "{} non-manifold vertices (non_manifold = {:?})",
+            out.non_manifold_vertices, params.non_manifold
+        ));
+    }
+    if out.pinch_vertices > 0 {
+        why.push(format!("{} vertices where boundary loops touch (pinches)", out.pinch_vertices));
+    }
+    if out.boundary_loops > 0 {
+        match holes {
+            None => why.push(format!("{} holes left open (fill_holes = false)", out.boundary_loops)),
+            Some(h) => {
+                for (reason, n) in &h.skipped_by_reason {
+                    why.push(format!("{n} holes skipped: {reason}"));
+                }
+                if h.skipped_by_reason.is_empty() {
+                    why.push(format!("{} boundary loops remain", out.boundary_loops));
+                }
+            }
+        }
+    }
+    why
+}
+
+/// The headline counts of a validation report.
+fn summary(r: &validate::Report) -> serde_json::Value {
+    serde_json::json!({
+        "vertices": r.vertices,
+        "faces": r.faces,
+        "components": r.components,
+        "boundary_loops": r.boundary_loops,
+        "non_manifold_edges": r.non_manifold_edges,
+        "non_manifold_vertices": r.non_manifold_vertices,
+        "pinch_vertices": r.pinch_vertices,
+        "degenerate_faces": r.degenerate_faces,
+        "duplicate_faces": r.duplicate_faces,
+        "unreferenced_vertices": r.unreferenced_vertices,
+        "inconsistent_orientation": r.inconsistent_orientation,
+        "euler_characteristic": r.euler_characteristic,
+        "genus": r.genus,
+        "closed": r.closed,
+        "manifold": r.manifold,
+        "volume": r.volume,
+    })
+}
+
+fn to_json<T: Serialize>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+}
