@@ -377,15 +377,17 @@ mod tests {
 
     #[test]
     fn ttl_expires_then_forgets() {
-        let mut s = Store::new(Duration::from_millis(30), 1 << 20, 100);
-        s.tombstone_min = Duration::ZERO;
+        let mut s = Store::new(Duration::from_millis(200), 1 << 20, 100);
         let a = s.insert("convert", Progress::new());
         s.finish(&a, Ok((Some(file(10)), serde_json::json!({"x": 1}))));
-        std::thread::sleep(Duration::from_millis(40));
+        s.sweep();
+        assert!(s.result(&a).is_ok(), "not expired before the TTL");
+        std::thread::sleep(Duration::from_millis(250));
         s.sweep();
         assert_eq!(s.status(&a).unwrap().removed.as_deref(), Some("expired"));
         assert_eq!(s.report(&a).err().unwrap().status, 410);
-        std::thread::sleep(Duration::from_millis(30));
+        s.tombstone_min = Duration::ZERO;
+        std::thread::sleep(Duration::from_millis(200));
         s.sweep();
         assert!(s.status(&a).is_none());
         assert_eq!(s.held_bytes(), 0);
