@@ -167,13 +167,7 @@ impl<'a> Store<'a> {
         let length = required_uint(view, "byteLength", &path)?;
         let data = &self.buffers[buffer];
         let end = offset.checked_add(length).filter(|&e| e <= data.len() as u64).ok_or_else(|| {
-            bad(
-                &path,
-                format!(
-                    "bytes {offset}..{offset}+{length} lie outside buffers[{buffer}] ({} bytes)",
-                    data.len()
-                ),
-            )
+            bad(&path, format!("bytes {offset}..{offset}+{length} lie outside buffers[{buffer}] ({} bytes)", data.len()))
         })?;
         let stride = match uint(view, "byteStride", &path)? {
             None => None,
@@ -188,9 +182,8 @@ impl<'a> Store<'a> {
         let path = format!("accessors[{i}]");
         let acc = object(&self.accessors[i], &path)?;
         let code = required_uint(acc, "componentType", &path)?;
-        let component = Component::from_code(code).ok_or_else(|| {
-            bad(join(&path, "componentType"), format!("{code} is not a glTF component type"))
-        })?;
+        let component = Component::from_code(code)
+            .ok_or_else(|| bad(join(&path, "componentType"), format!("{code} is not a glTF component type")))?;
         let count = required_uint(acc, "count", &path)?;
         if count == 0 {
             return Err(bad(join(&path, "count"), "must be at least 1"));
@@ -202,10 +195,7 @@ impl<'a> Store<'a> {
             "VEC3" => 3,
             "VEC4" => 4,
             "MAT2" | "MAT3" | "MAT4" => {
-                return Err(bad(
-                    join(&path, "type"),
-                    format!("{type_name} accessors are not used by mesh geometry"),
-                ))
+                return Err(bad(join(&path, "type"), format!("{type_name} accessors are not used by mesh geometry")))
             }
             other => return Err(bad(join(&path, "type"), format!("unknown type {other:?}"))),
         };
@@ -223,43 +213,23 @@ impl<'a> Store<'a> {
     pub fn floats(&self, h: &Header, max_count: usize) -> Result<Vec<f64>> {
         let n = h.normalized;
         match h.component {
-            Component::F32 => {
-                self.decode(h, max_count, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
-            }
-            Component::U32 => {
-                self.decode(h, max_count, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
-            }
+            Component::F32 => self.decode(h, max_count, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
+            Component::U32 => self.decode(h, max_count, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
             Component::I8 => self.decode(h, max_count, move |b| {
                 let v = b[0] as i8 as f64;
-                if n {
-                    (v / 127.0).max(-1.0)
-                } else {
-                    v
-                }
+                if n { (v / 127.0).max(-1.0) } else { v }
             }),
             Component::U8 => self.decode(h, max_count, move |b| {
                 let v = b[0] as f64;
-                if n {
-                    v / 255.0
-                } else {
-                    v
-                }
+                if n { v / 255.0 } else { v }
             }),
             Component::I16 => self.decode(h, max_count, move |b| {
                 let v = i16::from_le_bytes([b[0], b[1]]) as f64;
-                if n {
-                    (v / 32767.0).max(-1.0)
-                } else {
-                    v
-                }
+                if n { (v / 32767.0).max(-1.0) } else { v }
             }),
             Component::U16 => self.decode(h, max_count, move |b| {
                 let v = u16::from_le_bytes([b[0], b[1]]) as f64;
-                if n {
-                    v / 65535.0
-                } else {
-                    v
-                }
+                if n { v / 65535.0 } else { v }
             }),
         }
     }
@@ -274,12 +244,7 @@ impl<'a> Store<'a> {
         }
     }
 
-    fn decode<T: Copy + Default>(
-        &self,
-        h: &Header,
-        max_count: usize,
-        read: impl Fn(&[u8]) -> T,
-    ) -> Result<Vec<T>> {
+    fn decode<T: Copy + Default>(&self, h: &Header, max_count: usize, read: impl Fn(&[u8]) -> T) -> Result<Vec<T>> {
         let path = h.path();
         let acc = object(&self.accessors[h.index], &path)?;
         let elem = h.component.size() * h.width;
@@ -342,13 +307,7 @@ impl<'a> Store<'a> {
     }
 
     /// Replaces the elements listed by `accessors[i].sparse`.
-    fn apply_sparse<T: Copy>(
-        &self,
-        h: &Header,
-        sparse: &serde_json::Value,
-        out: &mut [T],
-        read: &impl Fn(&[u8]) -> T,
-    ) -> Result<()> {
+    fn apply_sparse<T: Copy>(&self, h: &Header, sparse: &serde_json::Value, out: &mut [T], read: &impl Fn(&[u8]) -> T) -> Result<()> {
         let path = format!("{}.sparse", h.path());
         let sparse = object(sparse, &path)?;
         let count = required_uint(sparse, "count", &path)?;
@@ -360,9 +319,9 @@ impl<'a> Store<'a> {
         let ipath = join(&path, "indices");
         let idx = object(sparse.get("indices").unwrap_or(&serde_json::Value::Null), &ipath)?;
         let icode = required_uint(idx, "componentType", &ipath)?;
-        let icomp = Component::from_code(icode).filter(|c| c.is_index_type()).ok_or_else(|| {
-            bad(join(&ipath, "componentType"), format!("{icode} is not an index component type"))
-        })?;
+        let icomp = Component::from_code(icode)
+            .filter(|c| c.is_index_type())
+            .ok_or_else(|| bad(join(&ipath, "componentType"), format!("{icode} is not an index component type")))?;
         let ibytes = self.sparse_slice(idx, &ipath, count, icomp.size())?;
 
         let vpath = join(&path, "values");
@@ -381,10 +340,7 @@ impl<'a> Store<'a> {
             if target >= h.count {
                 return Err(super::json::invalid(
                     &ipath,
-                    format!(
-                        "sparse index {target} (entry {k}) is outside the accessor's {} elements",
-                        h.count
-                    ),
+                    format!("sparse index {target} (entry {k}) is outside the accessor's {} elements", h.count),
                 ));
             }
             let el = &vbytes[k * elem..(k + 1) * elem];

@@ -128,11 +128,7 @@ impl GltfBuilder {
             "VEC2" => 2,
             "VEC3" => 3,
             "VEC4" => 4,
-            _ => {
-                return Err(Error::Internal(format!(
-                    "accessor type {type_name} not supported by the builder"
-                )))
-            }
+            _ => return Err(Error::Internal(format!("accessor type {type_name} not supported by the builder"))),
         };
         if values.is_empty() || values.len() % width != 0 {
             return Err(Error::Internal(format!(

@@ -23,8 +23,7 @@ use crate::io::{Format, Loaded, ReadOptions};
 use crate::mesh::{Faces, Mesh};
 
 /// Extensions that change how geometry is stored; without them we would read garbage.
-const UNSUPPORTED_REQUIRED: [&str; 3] =
-    ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"];
+const UNSUPPORTED_REQUIRED: [&str; 3] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"];
 
 /// Decodes glTF 2.0 JSON (with `data:` buffers) or GLB bytes.
 pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
@@ -145,9 +144,7 @@ impl<'a> Reader<'a> {
             if !self.meshes.is_empty() {
                 self.warnings.push("the file has no nodes: every mesh is read untransformed".into());
             }
-            return Ok((0..self.meshes.len())
-                .map(|m| Instance { mesh: m, world: IDENTITY, node_name: None })
-                .collect());
+            return Ok((0..self.meshes.len()).map(|m| Instance { mesh: m, world: IDENTITY, node_name: None }).collect());
         }
         let mut visited = vec![false; self.nodes.len()];
         let mut out = Vec::new();
@@ -159,10 +156,7 @@ impl<'a> Reader<'a> {
         while let Some((n, parent, via)) = stack.pop() {
             let path = format!("nodes[{n}]");
             if std::mem::replace(&mut visited[n], true) {
-                return Err(bad(
-                    via,
-                    format!("{path} is reached twice (a cycle, or a node with two parents)"),
-                ));
+                return Err(bad(via, format!("{path} is reached twice (a cycle, or a node with two parents)")));
             }
             let node = object(&self.nodes[n], &path)?;
             let world = transform::mul(&parent, &transform::local(node, &path)?);
@@ -178,8 +172,7 @@ impl<'a> Reader<'a> {
         }
         let mut used = vec![false; self.meshes.len()];
         out.iter().for_each(|i| used[i.mesh] = true);
-        let unused: Vec<String> =
-            (0..self.meshes.len()).filter(|&m| !used[m]).map(|m| format!("meshes[{m}]")).collect();
+        let unused: Vec<String> = (0..self.meshes.len()).filter(|&m| !used[m]).map(|m| format!("meshes[{m}]")).collect();
         if !unused.is_empty() {
             self.warnings.push(format!("not in the scene, not read: {}", unused.join(", ")));
         }
@@ -306,10 +299,7 @@ impl<'a> Reader<'a> {
     fn attribute(&self, i: usize, path: &str, types: &[&str]) -> Result<Header> {
         let h = self.store.header(i)?;
         if !types.contains(&h.type_name.as_str()) {
-            return Err(bad(
-                path,
-                format!("accessors[{i}] is {}, expected {}", h.type_name, types.join(" or ")),
-            ));
+            return Err(bad(path, format!("accessors[{i}] is {}, expected {}", h.type_name, types.join(" or "))));
         }
         Ok(h)
     }
@@ -341,10 +331,7 @@ impl<'a> Reader<'a> {
         for (e, p) in raw.chunks_exact(3).enumerate() {
             let q = transform::apply_point(world, [p[0], p[1], p[2]]);
             if !q.iter().all(|c| c.is_finite()) {
-                return Err(invalid(
-                    &prim.path,
-                    format!("vertex {e} becomes infinite under its node transform"),
-                ));
+                return Err(invalid(&prim.path, format!("vertex {e} becomes infinite under its node transform")));
             }
             out.positions.push(q);
         }
@@ -407,15 +394,7 @@ impl<'a> Reader<'a> {
         Ok(indices)
     }
 
-    fn triangles(
-        &mut self,
-        out: &mut Out,
-        prim: &Prim,
-        idx: &[u32],
-        base: u32,
-        group: u32,
-        flip: bool,
-    ) -> Result<()> {
+    fn triangles(&mut self, out: &mut Out, prim: &Prim, idx: &[u32], base: u32, group: u32, flip: bool) -> Result<()> {
         let n = idx.len();
         let tri = |k: usize| -> [u32; 3] {
             match prim.mode {
@@ -429,11 +408,7 @@ impl<'a> Reader<'a> {
         let count = match prim.mode {
             4 => {
                 if n % 3 != 0 {
-                    self.warnings.push(format!(
-                        "{}: {} trailing indices (not a whole triangle) ignored",
-                        prim.path,
-                        n % 3
-                    ));
+                    self.warnings.push(format!("{}: {} trailing indices (not a whole triangle) ignored", prim.path, n % 3));
                 }
                 n / 3
             }
@@ -490,9 +465,7 @@ impl<'a> Reader<'a> {
                 }
                 out.curves.push(c);
             }
-            _ => self
-                .warnings
-                .push(format!("{}: a line strip/loop needs 2 or more vertices, skipped", prim.path)),
+            _ => self.warnings.push(format!("{}: a line strip/loop needs 2 or more vertices, skipped", prim.path)),
         }
     }
 }
@@ -505,9 +478,7 @@ fn primitive_number(path: &str, fallback: usize) -> usize {
 fn check_finite(values: &[f64], width: usize, accessor: &str, used_as: &str) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
-        Some(i) => {
-            Err(invalid(accessor, format!("element {} (used as {used_as}) is NaN or infinite", i / width)))
-        }
+        Some(i) => Err(invalid(accessor, format!("element {} (used as {used_as}) is NaN or infinite", i / width))),
     }
 }
 
