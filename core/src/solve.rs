@@ -54,8 +54,9 @@ impl Cholesky {
     /// Symbolic analysis (AMD ordering, elimination tree, supernodes) of `a`'s pattern.
     pub fn analyze(a: &Csr) -> Result<Cholesky> {
         let m = as_faer(a)?;
-        let symbolic = factorize_symbolic_cholesky(m.symbolic(), Side::Lower, Default::default(), Default::default())
-            .map_err(|e| Error::numerical("cholesky analysis", format!("{e:?}")))?;
+        let symbolic =
+            factorize_symbolic_cholesky(m.symbolic(), Side::Lower, Default::default(), Default::default())
+                .map_err(|e| Error::numerical("cholesky analysis", format!("{e:?}")))?;
         let values = vec![0.0; symbolic.len_val()];
         Ok(Cholesky { symbolic, values, n: a.n, factored: false })
     }
@@ -77,7 +78,10 @@ impl Cholesky {
                 Default::default(),
             )
             .map_err(|e| {
-                Error::numerical("cholesky", format!("matrix is not positive definite ({e:?}); degenerate mesh?"))
+                Error::numerical(
+                    "cholesky",
+                    format!("matrix is not positive definite ({e:?}); degenerate mesh?"),
+                )
             })?;
         self.factored = true;
         Ok(())
@@ -122,7 +126,8 @@ pub fn pcg(a: &Csr, b: &[f64], x: &mut [f64], k: usize, tol: f64, max_iter: usiz
     r.par_iter_mut().zip(b).with_min_len(8192).for_each(|(r, b)| *r = b - *r);
     let bnorm = col_norms(b, k);
     let target: Vec<f64> = bnorm.iter().map(|&bn| tol * bn.max(f64::MIN_POSITIVE)).collect();
-    let mut z: Vec<f64> = r.par_iter().enumerate().with_min_len(8192).map(|(q, &r)| r * inv_diag[q / k]).collect();
+    let mut z: Vec<f64> =
+        r.par_iter().enumerate().with_min_len(8192).map(|(q, &r)| r * inv_diag[q / k]).collect();
     let mut p = z.clone();
     let mut rz = col_dots(&r, &z, k);
     let mut ap = vec![0.0; n * k];
@@ -178,12 +183,15 @@ fn col_dots(a: &[f64], b: &[f64], k: usize) -> Vec<f64> {
             }
             s
         })
-        .reduce(|| vec![0.0; k], |mut s, t| {
-            for c in 0..k {
-                s[c] += t[c];
-            }
-            s
-        })
+        .reduce(
+            || vec![0.0; k],
+            |mut s, t| {
+                for c in 0..k {
+                    s[c] += t[c];
+                }
+                s
+            },
+        )
 }
 
 fn col_norms(a: &[f64], k: usize) -> Vec<f64> {
@@ -236,7 +244,12 @@ impl Dirichlet {
     /// Refills the reduced values from `a` (same pattern as at construction).
     pub fn refill(&mut self, a: &Csr) {
         let src = &self.src;
-        self.reduced.val.par_iter_mut().zip(src).with_min_len(8192).for_each(|(v, &p)| *v = a.val[p as usize]);
+        self.reduced
+            .val
+            .par_iter_mut()
+            .zip(src)
+            .with_min_len(8192)
+            .for_each(|(v, &p)| *v = a.val[p as usize]);
     }
 
     /// Reduced right-hand side for column `c` of interleaved `k`-column data: `b_F − A_FP x_P`.

@@ -1,1 +1,275 @@
-//! Spatial queries: nearest vertex, closest point on a triangle mesh (AABB tree).
+//! Closest points on a triangle mesh: a bounding-volume hierarchy over the (fan-triangulated)
+//! faces, queried depth-first, nearer child first, pruning boxes farther than the best hit.
+//!
+//! Used for the Hausdorff distance in the smoothing report and for projecting vertices back onto
+//! a reference surface (tangential flows). Hand-written (≈150 lines) instead of a dependency.
+
+use rayon::prelude::*;
+
+use crate::geometry::{add, dot, scale, sub};
+use crate::mesh::{Faces, Point3};
+
+/// A hit: closest point, the input face it lies on, squared distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    pub point: Point3,
+    pub face: u32,
+    pub dist2: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    min: Point3,
+    max: Point3,
+    /// Leaf: first triangle (`count > 0`); inner: index of the left child (right = left + 1).
+    start: u32,
+    count: u32,
+}
+
+/// BVH over the triangles of a mesh (polygons are fan-triangulated; hits report the input face).
+pub struct Bvh {
+    nodes: Vec<Node>,
+    tris: Vec<[Point3; 3]>,
+    face_of: Vec<u32>,
+}
+
+const LEAF: usize = 4;
+
+impl Bvh {
+    pub fn new(positions: &[Point3], faces: &Faces) -> Bvh {
+        let mut tris = Vec::with_capacity(faces.len());
+        let mut face_of = Vec::with_capacity(faces.len());
+        for (fi, f) in faces.iter().enumerate() {
+            for k in 1..f.len().saturating_sub(1) {
+                tris.push([positions[f[0] as usize], positions[f[k] as usize], positions[f[k + 1] as usize]]);
+                face_of.push(fi as u32);
+            }
+        }
+        let mut order: Vec<u32> = (0..tris.len() as u32).collect();
+        let centroids: Vec<Point3> =
+            tris.iter().map(|t| scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0)).collect();
+        let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF + 1);
+        nodes.push(Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: 0 });
+        // Iterative build: (node index, range in `order`).
+        let mut stack = vec![(0usize, 0usize, order.len())];
+        while let Some((ni, lo, hi)) = stack.pop() {
+            let (mut bmin, mut bmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let (mut cmin, mut cmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for &t in &order[lo..hi] {
+                for p in &tris[t as usize] {
+                    for k in 0..3 {
+                        bmin[k] = bmin[k].min(p[k]);
+                        bmax[k] = bmax[k].max(p[k]);
+                    }
+                }
+                let c = centroids[t as usize];
+                for k in 0..3 {
+                    cmin[k] = cmin[k].min(c[k]);
+                    cmax[k] = cmax[k].max(c[k]);
+                }
+            }
+            nodes[ni].min = bmin;
+            nodes[ni].max = bmax;
+            if hi - lo <= LEAF {
+                nodes[ni].start = lo as u32;
+                nodes[ni].count = (hi - lo) as u32;
+                continue;
+            }
+            let ext = sub(cmax, cmin);
+            let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
+            let mid = (lo + hi) / 2;
+            order[lo..hi].select_nth_unstable_by(mid - lo, |a, b| {
+                centroids[*a as usize][axis].total_cmp(&centroids[*b as usize][axis])
+            });
+            let left = nodes.len();
+            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: 0 });
+            nodes.push(Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: 0 });
+            nodes[ni].start = left as u32;
+            nodes[ni].count = 0;
+            stack.push((left, lo, mid));
+            stack.push((left + 1, mid, hi));
+        }
+        let tris_sorted = order.iter().map(|&t| tris[t as usize]).collect();
+        let face_sorted = order.iter().map(|&t| face_of[t as usize]).collect();
+        Bvh { nodes, tris: tris_sorted, face_of: face_sorted }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+
+    /// The closest point of the surface to `p` (None for a mesh without faces).
+    pub fn closest(&self, p: Point3) -> Option<Closest> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let mut best = Closest { point: p, face: u32::MAX, dist2: f64::INFINITY };
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(ni) = stack.pop() {
+            let node = &self.nodes[ni as usize];
+            if box_dist2(node, p) >= best.dist2 {
+                continue;
+            }
+            if node.count > 0 {
+                for t in node.start..node.start + node.count {
+                    let q = closest_on_triangle(p, &self.tris[t as usize]);
+                    let d = dot(sub(q, p), sub(q, p));
+                    if d < best.dist2 {
+                        best = Closest { point: q, face: self.face_of[t as usize], dist2: d };
+                    }
+                }
+            } else {
+                let (l, r) = (node.start, node.start + 1);
+                let (dl, dr) = (box_dist2(&self.nodes[l as usize], p), box_dist2(&self.nodes[r as usize], p));
+                // Push the farther child first so the nearer one is explored first.
+                if dl < dr {
+                    stack.push(r);
+                    stack.push(l);
+                } else {
+                    stack.push(l);
+                    stack.push(r);
+                }
+            }
+        }
+        Some(best)
+    }
+
+    /// Largest distance from any of `points` to the surface (0 for no points or no faces).
+    pub fn max_distance(&self, points: &[Point3]) -> f64 {
+        points
+            .par_iter()
+            .with_min_len(1024)
+            .map(|&p| self.closest(p).map(|c| c.dist2.sqrt()).unwrap_or(0.0))
+            .reduce(|| 0.0, f64::max)
+    }
+}
+
+fn box_dist2(n: &Node, p: Point3) -> f64 {
+    let mut d = 0.0;
+    for k in 0..3 {
+        let v = (n.min[k] - p[k]).max(0.0).max(p[k] - n.max[k]);
+        d += v * v;
+    }
+    d
+}
+
+/// Closest point on triangle `t` to `p` (Ericson, Real-Time Collision Detection §5.1.5).
+pub fn closest_on_triangle(p: Point3, t: &[Point3; 3]) -> Point3 {
+    let [a, b, c] = *t;
+    let ab = sub(b, a);
+    let ac = sub(c, a);
+    let ap = sub(p, a);
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = sub(p, b);
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return add(a, scale(ab, v));
+    }
+    let cp = sub(p, c);
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return add(a, scale(ac, w));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return add(b, scale(sub(c, b), w));
+    }
+    let denom = va + vb + vc;
+    if denom.abs() < f64::MIN_POSITIVE {
+        // Degenerate triangle: fall back to the nearest vertex.
+        let da = dot(ap, ap);
+        let db = dot(bp, bp);
+        let dc = dot(cp, cp);
+        return if da <= db && da <= dc { a } else if db <= dc { b } else { c };
+    }
+    let v = vb / denom;
+    let w = vc / denom;
+    add(a, add(scale(ab, v), scale(ac, w)))
+}
+
+/// Symmetric Hausdorff distance between two surfaces, sampled at their vertices: the larger of
+/// max over A's vertices of the distance to surface B and vice versa. (Vertex sampling bounds
+/// the true Hausdorff distance from below; for smoothing, where both surfaces share connectivity,
+/// the two agree closely.) Vertices no face uses are not part of a surface and are skipped.
+pub fn hausdorff_vertices(a: &[Point3], fa: &Faces, b: &[Point3], fb: &Faces) -> f64 {
+    let used = |x: &[Point3], f: &Faces| -> Vec<Point3> {
+        let mut mark = vec![false; x.len()];
+        for &v in f.indices() {
+            mark[v as usize] = true;
+        }
+        x.iter().zip(&mark).filter(|(_, m)| **m).map(|(p, _)| *p).collect()
+    };
+    let (ba, bb) = rayon::join(|| Bvh::new(a, fa), || Bvh::new(b, fb));
+    let (d1, d2) = rayon::join(|| bb.max_distance(&used(a, fa)), || ba.max_distance(&used(b, fb)));
+    d1.max(d2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::norm;
+    use crate::shapes::{grid, icosphere};
+
+    #[test]
+    fn closest_point_regions_of_a_triangle() {
+        let t = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]];
+        let q = closest_on_triangle([0.2, 0.2, 5.0], &t);
+        assert!((q[0] - 0.2).abs() < 1e-15 && (q[1] - 0.2).abs() < 1e-15 && q[2] == 0.0);
+        assert_eq!(closest_on_triangle([-1., -1., 0.], &t), [0., 0., 0.]);
+        assert_eq!(closest_on_triangle([0.5, -2., 1.], &t), [0.5, 0., 0.]);
+        let q = closest_on_triangle([1., 1., 0.], &t);
+        assert!((q[0] - 0.5).abs() < 1e-15 && (q[1] - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bvh_matches_brute_force_on_a_sphere() {
+        let m = icosphere(3, 1.0);
+        let bvh = Bvh::new(&m.positions, &m.faces);
+        let tris = crate::shapes::fan_triangles(&m.faces);
+        for k in 0..200 {
+            let a = k as f64 * 0.731;
+            let p = [2.0 * a.cos() * (0.3 * a).sin(), 1.5 * a.sin(), 0.7 * (1.7 * a).cos()];
+            let hit = bvh.closest(p).unwrap();
+            let brute = tris
+                .iter()
+                .map(|t| {
+                    let q = closest_on_triangle(
+                        p,
+                        &[m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]],
+                    );
+                    dot(sub(q, p), sub(q, p))
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((hit.dist2 - brute).abs() < 1e-14, "{} vs {brute}", hit.dist2);
+        }
+    }
+
+    #[test]
+    fn hausdorff_of_a_lifted_plane() {
+        let a = grid(8, 8, 0.25, false);
+        let mut b = a.clone();
+        b.positions[40][2] = 0.3; // one interior vertex lifted
+        let h = hausdorff_vertices(&a.positions, &a.faces, &b.positions, &b.faces);
+        assert!((h - 0.3).abs() < 1e-15, "{h}");
+        assert_eq!(hausdorff_vertices(&a.positions, &a.faces, &a.positions, &a.faces), 0.0);
+        let _ = norm([0.0; 3]);
+    }
+}

@@ -23,7 +23,9 @@ fn round_trips(mesh: &Mesh) -> Vec<(Format, Mesh, Vec<String>)> {
 
 /// (group name, triangle) for every face, sorted: the partition independent of face order.
 fn named_faces(m: &Mesh) -> Vec<(String, Vec<u32>)> {
-    let mut v: Vec<_> = (0..m.face_count()).map(|i| (m.group_name(m.faces.group(i)).to_owned(), m.faces.get(i).to_vec())).collect();
+    let mut v: Vec<_> = (0..m.face_count())
+        .map(|i| (m.group_name(m.faces.group(i)).to_owned(), m.faces.get(i).to_vec()))
+        .collect();
     v.sort();
     v
 }
@@ -49,7 +51,11 @@ fn quads_come_back_fan_triangulated() {
     assert!(!mesh.faces.all_triangles());
     let fans = shapes::fan_triangles(&mesh.faces);
     for (format, back, _) in round_trips(&mesh) {
-        assert_eq!(back.faces.as_triangles().unwrap().chunks(3).map(|t| [t[0], t[1], t[2]]).collect::<Vec<_>>(), fans, "{format:?}");
+        assert_eq!(
+            back.faces.as_triangles().unwrap().chunks(3).map(|t| [t[0], t[1], t[2]]).collect::<Vec<_>>(),
+            fans,
+            "{format:?}"
+        );
         assert_eq!(back.positions.len(), mesh.positions.len());
     }
 }

@@ -70,7 +70,7 @@ pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
     let (cn, mut t) = if t.clone().next().is_some() {
         (hn, t)
     } else {
-        lines.next_content().ok_or_else(|| err(hn, "file ends before the counts line"))?
+        lines.next_content().ok_or_else(|| err(lines.line, "file ends before the counts line"))?
     };
     let nv = count(t.next(), "vertex", cn)?;
     let nf = count(t.next(), "face", cn)?;

@@ -223,7 +223,7 @@ trait Body {
     fn real(&mut self, ty: Ty) -> Result<f64>;
     fn int(&mut self, ty: Ty) -> Result<i64>;
     /// Where the next value starts (line or byte offset).
-    fn location(&self) -> Location;
+    fn location(&mut self) -> Location;
     /// Bytes not yet read (caps allocations).
     fn remaining(&self) -> usize;
     /// Skips `n` values of type `ty`.
@@ -287,7 +287,7 @@ impl Body for Binary<'_> {
         })
     }
 
-    fn location(&self) -> Location {
+    fn location(&mut self) -> Location {
         Location::Byte(self.pos)
     }
 
@@ -326,23 +326,28 @@ struct Ascii<'a> {
 }
 
 impl<'a> Ascii<'a> {
-    fn token(&mut self) -> Result<&'a [u8]> {
+    /// Moves to the start of the next token (or the end), counting lines.
+    fn skip_space(&mut self) {
         loop {
             while self.pos < self.bytes.len() && lex::is_space(self.bytes[self.pos]) {
                 self.pos += 1;
             }
             match self.bytes.get(self.pos) {
-                None => {
-                    // Report the file's last line, not the empty one after its final newline.
-                    let last = self.line - (self.pos > 0 && self.bytes[self.pos - 1] == b'\n') as usize;
-                    return Err(Error::malformed("ply", Location::Line(last), "data ends early"));
-                }
                 Some(b'\n') => {
                     self.pos += 1;
                     self.line += 1;
                 }
-                Some(_) => break,
+                _ => break,
             }
+        }
+    }
+
+    fn token(&mut self) -> Result<&'a [u8]> {
+        self.skip_space();
+        if self.pos >= self.bytes.len() {
+            // Report the file's last line, not the empty one after its final newline.
+            let last = self.line - (self.pos > 0 && self.bytes[self.pos - 1] == b'\n') as usize;
+            return Err(Error::malformed("ply", Location::Line(last), "data ends early"));
         }
         let start = self.pos;
         while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
@@ -374,7 +379,8 @@ impl Body for Ascii<'_> {
         }
     }
 
-    fn location(&self) -> Location {
+    fn location(&mut self) -> Location {
+        self.skip_space();
         Location::Line(self.line)
     }
 

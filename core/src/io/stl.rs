@@ -113,9 +113,12 @@ fn read_ascii(bytes: &[u8], opts: &ReadOptions) -> Result<(Soup, Vec<String>)> {
     let mut last = 0;
     for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
         let n = i + 1;
-        last = n;
         let mut t = Tokens::new(line);
-        match t.next() {
+        let key = t.next();
+        if key.is_some() {
+            last = n; // the last line with content, where a truncated file "ends"
+        }
+        match key {
             None => {}
             Some(b"solid") if !in_solid => {
                 in_solid = true;

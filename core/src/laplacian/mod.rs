@@ -40,8 +40,8 @@ pub mod csr;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-pub use csr::Csr;
 use csr::split_rows_mut;
+pub use csr::Csr;
 
 use crate::error::{Error, Result};
 use crate::geometry::{cross, dist, dot, norm, sub};
@@ -154,9 +154,8 @@ impl Stencil {
         }
         // Directed entries (row, col, pair) by counting sort on the row.
         let mut count = vec![0u32; n + 1];
-        let each_pair = |f: usize, g: &mut dyn FnMut(u32, u32, u32)| {
-            for_pairs(faces.get(f), pair_offset[f], layout, g)
-        };
+        let each_pair =
+            |f: usize, g: &mut dyn FnMut(u32, u32, u32)| for_pairs(faces.get(f), pair_offset[f], layout, g);
         for f in 0..nf {
             each_pair(f, &mut |a, b, _| {
                 if a != b {
@@ -448,7 +447,13 @@ pub fn face_terms(positions: &[Point3], faces: &Faces, stencil: &Stencil) -> Fac
 
 /// Fan-average terms of one polygon (see module docs); returns the number of degenerate fan
 /// triangles. `w` is in the stencil's pair layout, `c` per corner (bary, voronoi, ring).
-fn polygon_terms(positions: &[Point3], face: &[u32], layout: PairLayout, w: &mut [f64], c: &mut [[f64; 3]]) -> usize {
+fn polygon_terms(
+    positions: &[Point3],
+    face: &[u32],
+    layout: PairLayout,
+    w: &mut [f64],
+    c: &mut [[f64; 3]],
+) -> usize {
     let k = face.len();
     if k < 3 {
         return 0;
@@ -465,7 +470,11 @@ fn polygon_terms(positions: &[Point3], face: &[u32], layout: PairLayout, w: &mut
     for apex in 0..fans {
         for i in 1..k - 1 {
             let t = [apex, (apex + i) % k, (apex + i + 1) % k];
-            let p = [positions[face[t[0]] as usize], positions[face[t[1]] as usize], positions[face[t[2]] as usize]];
+            let p = [
+                positions[face[t[0]] as usize],
+                positions[face[t[1]] as usize],
+                positions[face[t[2]] as usize],
+            ];
             let (cot, vor, area, d) = triangle_terms(p);
             deg += d as usize;
             for q in 0..3 {
@@ -573,7 +582,11 @@ pub fn mass(positions: &[Point3], faces: &Faces, kind: MassKind) -> Result<Vec<f
 /// Boundary curve rows of eq. 4-3 (corrected): for each boundary vertex, `(j, B_ij)` for its
 /// boundary neighbours; the diagonal is 2. Edges shorter than `min_len` are skipped (a vertex left
 /// with no usable boundary edge gets no row and is treated as fixed by the caller).
-pub fn boundary_curve_rows(stencil: &Stencil, positions: &[Point3], min_len: f64) -> Vec<Option<Vec<(usize, f64)>>> {
+pub fn boundary_curve_rows(
+    stencil: &Stencil,
+    positions: &[Point3],
+    min_len: f64,
+) -> Vec<Option<Vec<(usize, f64)>>> {
     let boundary = stencil.boundary_vertices();
     (0..stencil.n)
         .map(|i| {

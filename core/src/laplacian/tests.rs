@@ -139,7 +139,8 @@ fn zero_row_sums_symmetry_and_linear_precision_on_hybrid_ngons() {
     let o = op(&m, OperatorKind::Tqlbo);
     let s = &o.stiffness;
     assert!(s.asymmetry() < 1e-14);
-    let boundary = Stencil::new(&m.faces, m.vertex_count(), PairLayout::AllPairs).unwrap().boundary_vertices();
+    let boundary =
+        Stencil::new(&m.faces, m.vertex_count(), PairLayout::AllPairs).unwrap().boundary_vertices();
     for i in 0..s.n {
         let (c, v) = s.row(i);
         assert!(v.iter().sum::<f64>().abs() < 1e-12);
@@ -175,7 +176,7 @@ fn boundary_curve_rows_are_second_differences() {
     assert_eq!(r.len(), 2);
     assert!(r.iter().all(|&(j, b)| (j == 1 || j == 3) && (b + 1.0).abs() < 1e-15));
     assert!(rows[12].is_none()); // interior
-    // Corner 0: neighbours 1 and 5; row sums with the diagonal 2 are zero.
+                                 // Corner 0: neighbours 1 and 5; row sums with the diagonal 2 are zero.
     let r0 = rows[0].as_ref().unwrap();
     assert!((r0.iter().map(|x| x.1).sum::<f64>() + 2.0).abs() < 1e-15);
 }

@@ -69,6 +69,15 @@ pub(super) struct Header {
     /// Components per element (1 for SCALAR … 4 for VEC4).
     pub width: usize,
     pub type_name: String,
+    layout: Option<Layout>,
+}
+
+/// Where an accessor's elements lie in its buffer view (already bounds-checked).
+#[derive(Clone, Copy, Debug)]
+struct Layout {
+    view: usize,
+    offset: usize,
+    stride: usize,
 }
 
 impl Header {
@@ -140,7 +149,7 @@ fn decode_data_uri(uri: &str, path: &str) -> Result<Vec<u8>> {
     if !header.ends_with(";base64") {
         return Err(bad(&p, "only base64 data: URIs are supported"));
     }
-    base64::decode(uri[comma + 1..].as_bytes())
+    base64::decode(&uri.as_bytes()[comma + 1..])
         .map_err(|at| bad(&p, format!("invalid base64 at character {at} of the data")))
 }
 
@@ -167,7 +176,13 @@ impl<'a> Store<'a> {
         let length = required_uint(view, "byteLength", &path)?;
         let data = &self.buffers[buffer];
         let end = offset.checked_add(length).filter(|&e| e <= data.len() as u64).ok_or_else(|| {
-            bad(&path, format!("bytes {offset}..{offset}+{length} lie outside buffers[{buffer}] ({} bytes)", data.len()))
+            bad(
+                &path,
+                format!(
+                    "bytes {offset}..{offset}+{length} lie outside buffers[{buffer}] ({} bytes)",
+                    data.len()
+                ),
+            )
         })?;
         let stride = match uint(view, "byteStride", &path)? {
             None => None,
@@ -182,8 +197,9 @@ impl<'a> Store<'a> {
         let path = format!("accessors[{i}]");
         let acc = object(&self.accessors[i], &path)?;
         let code = required_uint(acc, "componentType", &path)?;
-        let component = Component::from_code(code)
-            .ok_or_else(|| bad(join(&path, "componentType"), format!("{code} is not a glTF component type")))?;
+        let component = Component::from_code(code).ok_or_else(|| {
+            bad(join(&path, "componentType"), format!("{code} is not a glTF component type"))
+        })?;
         let count = required_uint(acc, "count", &path)?;
         if count == 0 {
             return Err(bad(join(&path, "count"), "must be at least 1"));
@@ -195,7 +211,10 @@ impl<'a> Store<'a> {
             "VEC3" => 3,
             "VEC4" => 4,
             "MAT2" | "MAT3" | "MAT4" => {
-                return Err(bad(join(&path, "type"), format!("{type_name} accessors are not used by mesh geometry")))
+                return Err(bad(
+                    join(&path, "type"),
+                    format!("{type_name} accessors are not used by mesh geometry"),
+                ))
             }
             other => return Err(bad(join(&path, "type"), format!("unknown type {other:?}"))),
         };
@@ -204,7 +223,39 @@ impl<'a> Store<'a> {
             return Err(bad(join(&path, "normalized"), format!("{} cannot be normalized", component.name())));
         }
         let count = usize::try_from(count).map_err(|_| bad(join(&path, "count"), "too large"))?;
-        Ok(Header { index: i, component, normalized, count, width, type_name: type_name.to_owned() })
+        let layout = self.layout(acc, &path, count, component.size() * width)?;
+        Ok(Header { index: i, component, normalized, count, width, type_name: type_name.to_owned(), layout })
+    }
+
+    /// Where the elements are, after checking (overflow-checked) that all `count` elements of
+    /// `elem` bytes lie inside the buffer view. `None`: no buffer view (all zeros).
+    fn layout(&self, acc: &Obj, path: &str, count: usize, elem: usize) -> Result<Option<Layout>> {
+        let Some(v) = index(acc, "bufferView", path, self.views.len(), "buffer view")? else {
+            return Ok(None);
+        };
+        let (bytes, stride) = self.view(v)?;
+        let stride = stride.unwrap_or(elem);
+        if stride < elem {
+            return Err(bad(
+                format!("bufferViews[{v}].byteStride"),
+                format!("{stride} is smaller than the {elem}-byte elements of {path}"),
+            ));
+        }
+        let offset = uint(acc, "byteOffset", path)?.unwrap_or(0);
+        let need = (count as u64 - 1)
+            .checked_mul(stride as u64)
+            .and_then(|x| x.checked_add(elem as u64))
+            .and_then(|x| x.checked_add(offset));
+        match need {
+            Some(need) if need <= bytes.len() as u64 => Ok(Some(Layout { view: v, offset: offset as usize, stride })),
+            _ => Err(bad(
+                path,
+                format!(
+                    "{count} elements of {elem} bytes (stride {stride}) from byte {offset} do not fit in bufferViews[{v}] ({} bytes)",
+                    bytes.len()
+                ),
+            )),
+        }
     }
 
     /// Decodes the elements of `h` as f64 (normalized integers mapped to [0, 1] or [-1, 1]),
@@ -213,23 +264,43 @@ impl<'a> Store<'a> {
     pub fn floats(&self, h: &Header, max_count: usize) -> Result<Vec<f64>> {
         let n = h.normalized;
         match h.component {
-            Component::F32 => self.decode(h, max_count, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
-            Component::U32 => self.decode(h, max_count, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
+            Component::F32 => {
+                self.decode(h, max_count, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
+            }
+            Component::U32 => {
+                self.decode(h, max_count, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64)
+            }
             Component::I8 => self.decode(h, max_count, move |b| {
                 let v = b[0] as i8 as f64;
-                if n { (v / 127.0).max(-1.0) } else { v }
+                if n {
+                    (v / 127.0).max(-1.0)
+                } else {
+                    v
+                }
             }),
             Component::U8 => self.decode(h, max_count, move |b| {
                 let v = b[0] as f64;
-                if n { v / 255.0 } else { v }
+                if n {
+                    v / 255.0
+                } else {
+                    v
+                }
             }),
             Component::I16 => self.decode(h, max_count, move |b| {
                 let v = i16::from_le_bytes([b[0], b[1]]) as f64;
-                if n { (v / 32767.0).max(-1.0) } else { v }
+                if n {
+                    (v / 32767.0).max(-1.0)
+                } else {
+                    v
+                }
             }),
             Component::U16 => self.decode(h, max_count, move |b| {
                 let v = u16::from_le_bytes([b[0], b[1]]) as f64;
-                if n { v / 65535.0 } else { v }
+                if n {
+                    v / 65535.0
+                } else {
+                    v
+                }
             }),
         }
     }
@@ -244,45 +315,26 @@ impl<'a> Store<'a> {
         }
     }
 
-    fn decode<T: Copy + Default>(&self, h: &Header, max_count: usize, read: impl Fn(&[u8]) -> T) -> Result<Vec<T>> {
+    fn decode<T: Copy + Default>(
+        &self,
+        h: &Header,
+        max_count: usize,
+        read: impl Fn(&[u8]) -> T,
+    ) -> Result<Vec<T>> {
         let path = h.path();
         let acc = object(&self.accessors[h.index], &path)?;
-        let elem = h.component.size() * h.width;
         let total = h.count.checked_mul(h.width).ok_or_else(|| bad(join(&path, "count"), "too large"))?;
         let mut out: Vec<T>;
-        match index(acc, "bufferView", &path, self.views.len(), "buffer view")? {
-            Some(v) => {
-                let (bytes, stride) = self.view(v)?;
-                let stride = stride.unwrap_or(elem);
-                if stride < elem {
-                    return Err(bad(
-                        format!("bufferViews[{v}].byteStride"),
-                        format!("{stride} is smaller than the {elem}-byte elements of {path}"),
-                    ));
-                }
-                let offset = uint(acc, "byteOffset", &path)?.unwrap_or(0);
-                let need = (h.count as u64 - 1)
-                    .checked_mul(stride as u64)
-                    .and_then(|x| x.checked_add(elem as u64))
-                    .and_then(|x| x.checked_add(offset));
-                match need {
-                    Some(need) if need <= bytes.len() as u64 => {}
-                    _ => {
-                        return Err(bad(
-                            &path,
-                            format!(
-                                "{} elements of {elem} bytes (stride {stride}) from byte {offset} do not fit in bufferViews[{v}] ({} bytes)",
-                                h.count,
-                                bytes.len()
-                            ),
-                        ))
-                    }
-                }
-                // Fits: the allocation is bounded by the data actually present.
+        match h.layout {
+            Some(Layout { view, offset, stride }) => {
+                // header() checked that every element lies inside the view: the allocation is
+                // bounded by the data actually present.
+                let (bytes, _) = self.view(view)?;
+                let elem = h.component.size() * h.width;
                 out = Vec::with_capacity(total);
                 let cs = h.component.size();
                 for e in 0..h.count {
-                    let start = offset as usize + e * stride;
+                    let start = offset + e * stride;
                     let el = &bytes[start..start + elem];
                     for c in 0..h.width {
                         out.push(read(&el[c * cs..(c + 1) * cs]));
@@ -307,7 +359,13 @@ impl<'a> Store<'a> {
     }
 
     /// Replaces the elements listed by `accessors[i].sparse`.
-    fn apply_sparse<T: Copy>(&self, h: &Header, sparse: &serde_json::Value, out: &mut [T], read: &impl Fn(&[u8]) -> T) -> Result<()> {
+    fn apply_sparse<T: Copy>(
+        &self,
+        h: &Header,
+        sparse: &serde_json::Value,
+        out: &mut [T],
+        read: &impl Fn(&[u8]) -> T,
+    ) -> Result<()> {
         let path = format!("{}.sparse", h.path());
         let sparse = object(sparse, &path)?;
         let count = required_uint(sparse, "count", &path)?;
@@ -319,9 +377,9 @@ impl<'a> Store<'a> {
         let ipath = join(&path, "indices");
         let idx = object(sparse.get("indices").unwrap_or(&serde_json::Value::Null), &ipath)?;
         let icode = required_uint(idx, "componentType", &ipath)?;
-        let icomp = Component::from_code(icode)
-            .filter(|c| c.is_index_type())
-            .ok_or_else(|| bad(join(&ipath, "componentType"), format!("{icode} is not an index component type")))?;
+        let icomp = Component::from_code(icode).filter(|c| c.is_index_type()).ok_or_else(|| {
+            bad(join(&ipath, "componentType"), format!("{icode} is not an index component type"))
+        })?;
         let ibytes = self.sparse_slice(idx, &ipath, count, icomp.size())?;
 
         let vpath = join(&path, "values");
@@ -340,7 +398,10 @@ impl<'a> Store<'a> {
             if target >= h.count {
                 return Err(super::json::invalid(
                     &ipath,
-                    format!("sparse index {target} (entry {k}) is outside the accessor's {} elements", h.count),
+                    format!(
+                        "sparse index {target} (entry {k}) is outside the accessor's {} elements",
+                        h.count
+                    ),
                 ));
             }
             let el = &vbytes[k * elem..(k + 1) * elem];

@@ -64,7 +64,7 @@ pub struct GltfBuilder {
 }
 
 fn pad_to_4(bytes: &mut Vec<u8>, fill: u8) {
-    while bytes.len() % 4 != 0 {
+    while !bytes.len().is_multiple_of(4) {
         bytes.push(fill);
     }
 }
@@ -128,9 +128,13 @@ impl GltfBuilder {
             "VEC2" => 2,
             "VEC3" => 3,
             "VEC4" => 4,
-            _ => return Err(Error::Internal(format!("accessor type {type_name} not supported by the builder"))),
+            _ => {
+                return Err(Error::Internal(format!(
+                    "accessor type {type_name} not supported by the builder"
+                )))
+            }
         };
-        if values.is_empty() || values.len() % width != 0 {
+        if values.is_empty() || !values.len().is_multiple_of(width) {
             return Err(Error::Internal(format!(
                 "accessor of {} floats cannot hold {type_name} elements (glTF needs count ≥ 1)",
                 values.len()

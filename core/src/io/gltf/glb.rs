@@ -27,7 +27,10 @@ fn u32_at(bytes: &[u8], at: usize) -> Option<u32> {
 pub(super) fn parse(bytes: &[u8]) -> Result<Glb<'_>> {
     let actual = bytes.len();
     if actual < 12 {
-        return Err(bad(actual, format!("truncated header: a GLB header is 12 bytes, the file has {actual}")));
+        return Err(bad(
+            actual,
+            format!("truncated header: a GLB header is 12 bytes, the file has {actual}"),
+        ));
     }
     let version = u32_at(bytes, 4).unwrap_or(0);
     if version != 2 {
@@ -35,7 +38,10 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Glb<'_>> {
     }
     let declared = u32_at(bytes, 8).unwrap_or(0) as usize;
     if declared > actual {
-        return Err(bad(actual, format!("truncated: the header declares {declared} bytes, the file ends at byte {actual}")));
+        return Err(bad(
+            actual,
+            format!("truncated: the header declares {declared} bytes, the file ends at byte {actual}"),
+        ));
     }
     if declared < actual {
         return Err(bad(8, format!("the header declares {declared} bytes but the file has {actual}")));
@@ -59,7 +65,9 @@ pub(super) fn parse(bytes: &[u8]) -> Result<Glb<'_>> {
         let data = &bytes[start..end];
         match (index, kind) {
             (0, CHUNK_JSON) => json = Some((data, start)),
-            (0, _) => return Err(bad(at + 4, format!("the first chunk must be JSON, found type 0x{kind:08x}"))),
+            (0, _) => {
+                return Err(bad(at + 4, format!("the first chunk must be JSON, found type 0x{kind:08x}")))
+            }
             (_, CHUNK_JSON) => return Err(bad(at + 4, "a second JSON chunk")),
             (1, CHUNK_BIN) => bin = Some(data),
             (_, CHUNK_BIN) => return Err(bad(at + 4, "a BIN chunk that is not the second chunk")),

@@ -42,7 +42,10 @@ pub(super) fn join(path: &str, key: &str) -> String {
 pub(super) fn uint(obj: &Obj, key: &str, path: &str) -> Result<Option<u64>> {
     match obj.get(key) {
         None => Ok(None),
-        Some(v) => v.as_u64().map(Some).ok_or_else(|| bad(join(path, key), format!("must be a non-negative integer, found {v}"))),
+        Some(v) => v
+            .as_u64()
+            .map(Some)
+            .ok_or_else(|| bad(join(path, key), format!("must be a non-negative integer, found {v}"))),
     }
 }
 
@@ -94,7 +97,10 @@ pub(super) fn numbers<const N: usize>(obj: &Obj, key: &str, path: &str) -> Resul
     }
     let mut out = [0.0; N];
     for (o, x) in out.iter_mut().zip(a) {
-        *o = x.as_f64().filter(|f| f.is_finite()).ok_or_else(|| bad(&p, format!("{x} is not a finite number")))?;
+        *o = x
+            .as_f64()
+            .filter(|f| f.is_finite())
+            .ok_or_else(|| bad(&p, format!("{x} is not a finite number")))?;
     }
     Ok(Some(out))
 }

@@ -23,7 +23,8 @@ use crate::io::{Format, Loaded, ReadOptions};
 use crate::mesh::{Faces, Mesh};
 
 /// Extensions that change how geometry is stored; without them we would read garbage.
-const UNSUPPORTED_REQUIRED: [&str; 3] = ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"];
+const UNSUPPORTED_REQUIRED: [&str; 3] =
+    ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression"];
 
 /// Decodes glTF 2.0 JSON (with `data:` buffers) or GLB bytes.
 pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
@@ -80,6 +81,9 @@ struct Prim<'a> {
     normal: Option<usize>,
     texcoord: Option<usize>,
 }
+
+/// Identifies a vertex block: world matrix (bit pattern), POSITION, NORMAL, TEXCOORD_0 accessors.
+type BlockKey = ([u64; 16], usize, Option<usize>, Option<usize>);
 
 /// Where a decoded vertex block sits in the output.
 #[derive(Clone, Copy)]
@@ -144,7 +148,9 @@ impl<'a> Reader<'a> {
             if !self.meshes.is_empty() {
                 self.warnings.push("the file has no nodes: every mesh is read untransformed".into());
             }
-            return Ok((0..self.meshes.len()).map(|m| Instance { mesh: m, world: IDENTITY, node_name: None }).collect());
+            return Ok((0..self.meshes.len())
+                .map(|m| Instance { mesh: m, world: IDENTITY, node_name: None })
+                .collect());
         }
         let mut visited = vec![false; self.nodes.len()];
         let mut out = Vec::new();
@@ -156,7 +162,10 @@ impl<'a> Reader<'a> {
         while let Some((n, parent, via)) = stack.pop() {
             let path = format!("nodes[{n}]");
             if std::mem::replace(&mut visited[n], true) {
-                return Err(bad(via, format!("{path} is reached twice (a cycle, or a node with two parents)")));
+                return Err(bad(
+                    via,
+                    format!("{path} is reached twice (a cycle, or a node with two parents)"),
+                ));
             }
             let node = object(&self.nodes[n], &path)?;
             let world = transform::mul(&parent, &transform::local(node, &path)?);
@@ -172,7 +181,8 @@ impl<'a> Reader<'a> {
         }
         let mut used = vec![false; self.meshes.len()];
         out.iter().for_each(|i| used[i.mesh] = true);
-        let unused: Vec<String> = (0..self.meshes.len()).filter(|&m| !used[m]).map(|m| format!("meshes[{m}]")).collect();
+        let unused: Vec<String> =
+            (0..self.meshes.len()).filter(|&m| !used[m]).map(|m| format!("meshes[{m}]")).collect();
         if !unused.is_empty() {
             self.warnings.push(format!("not in the scene, not read: {}", unused.join(", ")));
         }
@@ -218,9 +228,8 @@ impl<'a> Reader<'a> {
         // Pass 1 (JSON only): which primitives, and do they all have normals / texcoords?
         let mut per_mesh: HashMap<usize, Vec<Prim<'a>>> = HashMap::new();
         for inst in instances {
-            if !per_mesh.contains_key(&inst.mesh) {
-                let prims = self.primitives(inst.mesh)?;
-                per_mesh.insert(inst.mesh, prims);
+            if let std::collections::hash_map::Entry::Vacant(e) = per_mesh.entry(inst.mesh) {
+                e.insert(self.primitives(inst.mesh)?);
             }
         }
         let all_prims = || instances.iter().flat_map(|i| per_mesh[&i.mesh].iter());
@@ -246,7 +255,7 @@ impl<'a> Reader<'a> {
 
         // Pass 2: decode and merge.
         let mut out = Out::new(keep_normals, keep_uvs);
-        let mut blocks: HashMap<([u64; 16], usize, Option<usize>, Option<usize>), Block> = HashMap::new();
+        let mut blocks: HashMap<BlockKey, Block> = HashMap::new();
         for inst in instances {
             let prims = &per_mesh[&inst.mesh];
             let mesh_name = self.mesh_name(inst)?;
@@ -299,7 +308,10 @@ impl<'a> Reader<'a> {
     fn attribute(&self, i: usize, path: &str, types: &[&str]) -> Result<Header> {
         let h = self.store.header(i)?;
         if !types.contains(&h.type_name.as_str()) {
-            return Err(bad(path, format!("accessors[{i}] is {}, expected {}", h.type_name, types.join(" or "))));
+            return Err(bad(
+                path,
+                format!("accessors[{i}] is {}, expected {}", h.type_name, types.join(" or ")),
+            ));
         }
         Ok(h)
     }
@@ -331,7 +343,10 @@ impl<'a> Reader<'a> {
         for (e, p) in raw.chunks_exact(3).enumerate() {
             let q = transform::apply_point(world, [p[0], p[1], p[2]]);
             if !q.iter().all(|c| c.is_finite()) {
-                return Err(invalid(&prim.path, format!("vertex {e} becomes infinite under its node transform")));
+                return Err(invalid(
+                    &prim.path,
+                    format!("vertex {e} becomes infinite under its node transform"),
+                ));
             }
             out.positions.push(q);
         }
@@ -394,21 +409,33 @@ impl<'a> Reader<'a> {
         Ok(indices)
     }
 
-    fn triangles(&mut self, out: &mut Out, prim: &Prim, idx: &[u32], base: u32, group: u32, flip: bool) -> Result<()> {
+    fn triangles(
+        &mut self,
+        out: &mut Out,
+        prim: &Prim,
+        idx: &[u32],
+        base: u32,
+        group: u32,
+        flip: bool,
+    ) -> Result<()> {
         let n = idx.len();
         let tri = |k: usize| -> [u32; 3] {
             match prim.mode {
                 4 => [idx[3 * k], idx[3 * k + 1], idx[3 * k + 2]],
                 // Strips alternate winding: odd triangles swap their last two vertices (spec 3.7.2.1).
-                5 if k % 2 == 0 => [idx[k], idx[k + 1], idx[k + 2]],
+                5 if k.is_multiple_of(2) => [idx[k], idx[k + 1], idx[k + 2]],
                 5 => [idx[k], idx[k + 2], idx[k + 1]],
                 _ => [idx[k + 1], idx[k + 2], idx[0]],
             }
         };
         let count = match prim.mode {
             4 => {
-                if n % 3 != 0 {
-                    self.warnings.push(format!("{}: {} trailing indices (not a whole triangle) ignored", prim.path, n % 3));
+                if !n.is_multiple_of(3) {
+                    self.warnings.push(format!(
+                        "{}: {} trailing indices (not a whole triangle) ignored",
+                        prim.path,
+                        n % 3
+                    ));
                 }
                 n / 3
             }
@@ -439,7 +466,7 @@ impl<'a> Reader<'a> {
         let shifted = idx.iter().map(|&i| i + base);
         match prim.mode {
             1 => {
-                if idx.len() % 2 == 1 {
+                if !idx.len().is_multiple_of(2) {
                     self.warnings.push(format!("{}: odd index count, last LINES index ignored", prim.path));
                 }
                 // Consecutive segments that share an end point are joined into one polyline.
@@ -465,7 +492,9 @@ impl<'a> Reader<'a> {
                 }
                 out.curves.push(c);
             }
-            _ => self.warnings.push(format!("{}: a line strip/loop needs 2 or more vertices, skipped", prim.path)),
+            _ => self
+                .warnings
+                .push(format!("{}: a line strip/loop needs 2 or more vertices, skipped", prim.path)),
         }
     }
 }
@@ -478,7 +507,9 @@ fn primitive_number(path: &str, fallback: usize) -> usize {
 fn check_finite(values: &[f64], width: usize, accessor: &str, used_as: &str) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
-        Some(i) => Err(invalid(accessor, format!("element {} (used as {used_as}) is NaN or infinite", i / width))),
+        Some(i) => {
+            Err(invalid(accessor, format!("element {} (used as {used_as}) is NaN or infinite", i / width)))
+        }
     }
 }
 

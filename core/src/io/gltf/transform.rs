@@ -6,7 +6,8 @@ use crate::error::Result;
 /// Column-major: element (row r, column c) is `m[c * 4 + r]`.
 pub(super) type Mat4 = [f64; 16];
 
-pub(super) const IDENTITY: Mat4 = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+pub(super) const IDENTITY: Mat4 =
+    [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
 
 pub(super) fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut m = [0.0; 16];
@@ -59,7 +60,8 @@ pub(super) fn apply_point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
 
 /// Determinant of the upper 3×3 (negative: the transform mirrors, so winding must flip).
 pub(super) fn det3(m: &Mat4) -> f64 {
-    m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2])
+    m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2])
+        + m[8] * (m[1] * m[6] - m[5] * m[2])
 }
 
 /// Matrix that maps normals: the cofactor matrix of the upper 3×3 (= det · inverse-transpose),

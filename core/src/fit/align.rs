@@ -1,0 +1,239 @@
+//! Automatic initial alignment when the user gives no correspondence pairs: PCA of the template
+//! vertices against the curve points for a start, then similarity ICP (rotation, translation,
+//! uniform scale; Horn's quaternion method). PCA axes have sign ambiguities, so the four proper
+//! sign choices are each refined by ICP and the best fit wins. Symmetric templates can still
+//! align in more than one way: pairs are the reliable route (the seed always uses them).
+
+use crate::geometry::{add, dot, norm2, scale, sub};
+use crate::job::Progress;
+use crate::error::Result;
+use crate::mesh::Point3;
+
+use super::kdtree::KdTree;
+
+/// Eigen-decomposition of a small symmetric matrix (row-major `n×n`) by cyclic Jacobi rotations.
+/// Returns the eigenvalues and the eigenvectors as columns (`vecs[i * n + k]` is component `i` of
+/// vector `k`).
+pub fn sym_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut a = a.to_vec();
+    let mut v = vec![0.0; n * n];
+    for i in 0..n {
+        v[i * n + i] = 1.0;
+    }
+    for _sweep in 0..64 {
+        let off: f64 = (0..n).flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j))).map(|(i, j)| a[i * n + j].powi(2)).sum();
+        let diag: f64 = (0..n).map(|i| a[i * n + i].powi(2)).sum();
+        if off <= 1e-30 * diag.max(1e-300) {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = a[p * n + q];
+                if apq.abs() < 1e-300 {
+                    continue;
+                }
+                let theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..n {
+                    let akp = a[k * n + p];
+                    let akq = a[k * n + q];
+                    a[k * n + p] = c * akp - s * akq;
+                    a[k * n + q] = s * akp + c * akq;
+                }
+                for k in 0..n {
+                    let apk = a[p * n + k];
+                    let aqk = a[q * n + k];
+                    a[p * n + k] = c * apk - s * aqk;
+                    a[q * n + k] = s * apk + c * aqk;
+                }
+                for k in 0..n {
+                    let vkp = v[k * n + p];
+                    let vkq = v[k * n + q];
+                    v[k * n + p] = c * vkp - s * vkq;
+                    v[k * n + q] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    ((0..n).map(|i| a[i * n + i]).collect(), v)
+}
+
+/// x ↦ s·R·x + t.
+#[derive(Debug, Clone, Copy)]
+pub struct Similarity {
+    pub r: [[f64; 3]; 3],
+    pub s: f64,
+    pub t: Point3,
+}
+
+impl Similarity {
+    pub fn apply(&self, p: Point3) -> Point3 {
+        let r = &self.r;
+        let q = [dot(r[0], p), dot(r[1], p), dot(r[2], p)];
+        add(scale(q, self.s), self.t)
+    }
+
+    pub fn inverse_apply(&self, p: Point3) -> Point3 {
+        let d = scale(sub(p, self.t), 1.0 / self.s);
+        let r = &self.r;
+        [
+            r[0][0] * d[0] + r[1][0] * d[1] + r[2][0] * d[2],
+            r[0][1] * d[0] + r[1][1] * d[1] + r[2][1] * d[2],
+            r[0][2] * d[0] + r[1][2] * d[1] + r[2][2] * d[2],
+        ]
+    }
+}
+
+fn mean(p: &[Point3]) -> Point3 {
+    let mut m = [0.0; 3];
+    for q in p {
+        m = add(m, *q);
+    }
+    scale(m, 1.0 / p.len().max(1) as f64)
+}
+
+/// Principal axes (columns, largest spread first) and the spreads.
+fn pca(p: &[Point3]) -> ([[f64; 3]; 3], [f64; 3]) {
+    let m = mean(p);
+    let mut c = vec![0.0; 9];
+    for q in p {
+        let d = sub(*q, m);
+        for i in 0..3 {
+            for j in 0..3 {
+                c[i * 3 + j] += d[i] * d[j];
+            }
+        }
+    }
+    let (vals, vecs) = sym_eigen(&c, 3);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| vals[b].total_cmp(&vals[a]));
+    let mut axes = [[0.0; 3]; 3];
+    let mut spread = [0.0; 3];
+    for (k, &o) in order.iter().enumerate() {
+        for i in 0..3 {
+            axes[i][k] = vecs[i * 3 + o];
+        }
+        spread[k] = vals[o].max(0.0);
+    }
+    (axes, spread)
+}
+
+/// Best similarity taking `from[i]` to `to[i]` (Horn 1987, with scale).
+pub fn fit_similarity(from: &[Point3], to: &[Point3]) -> Similarity {
+    let (mf, mt) = (mean(from), mean(to));
+    let mut s = [[0.0; 3]; 3];
+    let mut var = 0.0;
+    for (a, b) in from.iter().zip(to) {
+        let (a, b) = (sub(*a, mf), sub(*b, mt));
+        var += norm2(a);
+        for i in 0..3 {
+            for j in 0..3 {
+                s[i][j] += a[i] * b[j];
+            }
+        }
+    }
+    let (sxx, sxy, sxz, syx, syy, syz, szx, szy, szz) =
+        (s[0][0], s[0][1], s[0][2], s[1][0], s[1][1], s[1][2], s[2][0], s[2][1], s[2][2]);
+    let nmat = [
+        sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,
+        syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,
+        szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,
+        sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz,
+    ];
+    let (vals, vecs) = sym_eigen(&nmat, 4);
+    let k = (0..4).max_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap_or(0);
+    let (w, x, y, z) = (vecs[k], vecs[4 + k], vecs[8 + k], vecs[12 + k]);
+    let r = [
+        [w * w + x * x - y * y - z * z, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
+        [2.0 * (x * y + w * z), w * w - x * x + y * y - z * z, 2.0 * (y * z - w * x)],
+        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z],
+    ];
+    let mut num = 0.0;
+    for (a, b) in from.iter().zip(to) {
+        let a = sub(*a, mf);
+        let ra = [dot(r[0], a), dot(r[1], a), dot(r[2], a)];
+        num += dot(ra, sub(*b, mt));
+    }
+    let sc = if var > 0.0 && num > 0.0 { num / var } else { 1.0 };
+    let rm = [dot(r[0], mf), dot(r[1], mf), dot(r[2], mf)];
+    Similarity { r, s: sc, t: sub(mt, scale(rm, sc)) }
+}
+
+/// PCA start + similarity ICP. Returns the map template → curve space and its final RMS distance.
+pub fn pca_icp(template: &[Point3], curve: &[Point3], iterations: u32, progress: &Progress) -> Result<(Similarity, f64)> {
+    let tree = KdTree::new(template);
+    let (at, st) = pca(template);
+    let (ac, sc) = pca(curve);
+    let (mt, mc) = (mean(template), mean(curve));
+    let s0 = ((sc[0] + sc[1] + sc[2]) / curve.len() as f64 / ((st[0] + st[1] + st[2]) / template.len() as f64)).sqrt();
+    let s0 = if s0.is_finite() && s0 > 0.0 { s0 } else { 1.0 };
+    let mut best: Option<(Similarity, f64)> = None;
+    for signs in [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]] {
+        // R = Ac · diag(signs) · Atᵀ (both proper when the PCA frames are; fix handedness).
+        let mut r = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                r[i][j] = (0..3).map(|k| ac[i][k] * signs[k] * at[j][k]).sum();
+            }
+        }
+        let det = dot(r[0], crate::geometry::cross(r[1], r[2]));
+        if det < 0.0 {
+            for row in r.iter_mut() {
+                for v in row.iter_mut() {
+                    *v = -*v;
+                }
+            }
+        }
+        let rm = [dot(r[0], mt), dot(r[1], mt), dot(r[2], mt)];
+        let mut m = Similarity { r, s: s0, t: sub(mc, scale(rm, s0)) };
+        let mut rms = f64::INFINITY;
+        for _ in 0..iterations {
+            progress.check()?;
+            let mut from = Vec::with_capacity(curve.len());
+            let mut err = 0.0;
+            for &c in curve {
+                if let Some((i, _)) = tree.nearest(m.inverse_apply(c)) {
+                    let p = template[i as usize];
+                    err += norm2(sub(m.apply(p), c));
+                    from.push(p);
+                }
+            }
+            rms = (err / curve.len().max(1) as f64).sqrt();
+            m = fit_similarity(&from, curve);
+        }
+        if best.as_ref().is_none_or(|b| rms < b.1) {
+            best = Some((m, rms));
+        }
+    }
+    Ok(best.unwrap_or((Similarity { r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], s: 1.0, t: [0.0; 3] }, f64::INFINITY)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobi_finds_known_eigenvalues() {
+        // [[2,1],[1,2]] has eigenvalues 1 and 3.
+        let (mut v, _) = sym_eigen(&[2.0, 1.0, 1.0, 2.0], 2);
+        v.sort_by(f64::total_cmp);
+        assert!((v[0] - 1.0).abs() < 1e-12 && (v[1] - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn horn_recovers_a_similarity() {
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let truth = Similarity { r: [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], s: 1.7, t: [1.0, -2.0, 3.0] };
+        let from: Vec<Point3> = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0], [1.0, 1.0, 1.0]];
+        let to: Vec<Point3> = from.iter().map(|&p| truth.apply(p)).collect();
+        let m = fit_similarity(&from, &to);
+        for p in [[5.0, 1.0, -2.0], [0.1, 0.2, 0.3]] {
+            let (a, b) = (m.apply(p), truth.apply(p));
+            assert!(crate::geometry::dist(a, b) < 1e-9, "{a:?} {b:?}");
+            assert!(crate::geometry::dist(m.inverse_apply(b), p) < 1e-9);
+        }
+    }
+}

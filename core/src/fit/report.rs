@@ -1,0 +1,132 @@
+//! Quality measures of the fit report.
+
+use serde::Serialize;
+
+use crate::geometry::{add, corner_angle, dist, dot, normalize, scale, triangle_cross};
+use crate::mesh::{Mesh, Point3};
+
+use super::curves::CurveNetwork;
+use super::kdtree::KdTree;
+use super::retriangulate::Realised;
+use super::trimesh::IntMap;
+
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct AngleStats {
+    pub min_deg: f64,
+    pub mean_min_deg: f64,
+    pub below_10: usize,
+}
+
+/// Smallest corner angle over all triangles, the mean of the per-triangle minimum, and the number
+/// of triangles with a corner below 10°.
+pub fn angle_stats(pos: &[Point3], tris: &[[u32; 3]]) -> AngleStats {
+    let (mut min, mut sum, mut below) = (180.0f64, 0.0, 0);
+    for t in tris {
+        let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+        let m = corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b)).to_degrees();
+        min = min.min(m);
+        sum += m;
+        below += (m < 10.0) as usize;
+    }
+    AngleStats { min_deg: min, mean_min_deg: sum / tris.len().max(1) as f64, below_10: below }
+}
+
+/// Area-weighted unit vertex normals.
+pub fn vertex_normals(pos: &[Point3], tris: &[[u32; 3]]) -> Vec<Point3> {
+    let mut n = vec![[0.0; 3]; pos.len()];
+    for t in tris {
+        let f = triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+        for &v in t {
+            n[v as usize] = add(n[v as usize], f);
+        }
+    }
+    n.into_iter().map(normalize).collect()
+}
+
+/// The input polylines as chains of output mesh vertices.
+pub fn polyline_chains(net: &CurveNetwork, chains: &[Vec<u32>]) -> Vec<Vec<u32>> {
+    let mut seg_of: IntMap<(u32, u32), usize> = IntMap::default();
+    for (i, s) in net.segments.iter().enumerate() {
+        seg_of.insert((s[0], s[1]), i);
+    }
+    net.polylines
+        .iter()
+        .map(|line| {
+            let mut out: Vec<u32> = Vec::new();
+            for w in line.windows(2) {
+                let key = (w[0].min(w[1]), w[0].max(w[1]));
+                let Some(&si) = seg_of.get(&key) else { continue };
+                let mut c = chains[si].clone();
+                if net.segments[si][0] != w[0] {
+                    c.reverse();
+                }
+                let skip = usize::from(!out.is_empty());
+                out.extend_from_slice(&c[skip..]);
+            }
+            out
+        })
+        .collect()
+}
+
+pub struct Quality {
+    pub curve_residual_max: f64,
+    pub curve_residual_mean: f64,
+    pub chain_deviation_max: f64,
+    pub segments_as_edges: f64,
+    pub flipped_faces: usize,
+}
+
+impl Quality {
+    /// `reference_pos`/`reference_normals`: the fine-deformed mesh before re-triangulation; an
+    /// output face counts as flipped when its normal opposes the reference normal nearest to it.
+    pub fn measure(
+        out: &Mesh,
+        net: &CurveNetwork,
+        vertex_of_point: &[u32],
+        realised: &Realised,
+        tris: &[[u32; 3]],
+        reference_pos: &[Point3],
+        reference_normals: &[Point3],
+    ) -> Quality {
+        let pos = &out.positions;
+        let res: Vec<f64> = (0..net.points.len()).map(|p| dist(pos[vertex_of_point[p] as usize], net.points[p])).collect();
+        let mut dev = 0.0f64;
+        for (si, c) in realised.chains.iter().enumerate() {
+            let (a, b) = (net.points[net.segments[si][0] as usize], net.points[net.segments[si][1] as usize]);
+            for &v in &c[1..c.len().saturating_sub(1)] {
+                dev = dev.max(super::point_segment_distance(pos[v as usize], a, b));
+            }
+        }
+        let mut edges: IntMap<(u32, u32), ()> = IntMap::default();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                edges.insert((a.min(b), a.max(b)), ());
+            }
+        }
+        let ok = realised
+            .chains
+            .iter()
+            .filter(|c| c.len() >= 2 && c.windows(2).all(|w| edges.contains_key(&(w[0].min(w[1]), w[0].max(w[1])))))
+            .count();
+        let tree = KdTree::new(reference_pos);
+        let flipped = tris
+            .iter()
+            .filter(|t| {
+                let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+                let centroid = scale(add(add(a, b), c), 1.0 / 3.0);
+                match tree.nearest(centroid) {
+                    Some((v, _)) => dot(triangle_cross(a, b, c), reference_normals[v as usize]) < 0.0,
+                    None => false,
+                }
+            })
+            .count();
+        Quality {
+            curve_residual_max: res.iter().cloned().fold(0.0, f64::max),
+            curve_residual_mean: res.iter().sum::<f64>() / res.len().max(1) as f64,
+            chain_deviation_max: dev,
+            segments_as_edges: ok as f64 / realised.chains.len().max(1) as f64,
+            flipped_faces: flipped,
+        }
+    }
+}

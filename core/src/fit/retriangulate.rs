@@ -1,0 +1,494 @@
+//! Partitioning, part 1 (Ch. 3): make every curve segment a chain of mesh edges.
+//!
+//! For a segment (u, w) whose ends are already mesh vertices (after the fine deformation), we walk
+//! from u to w across the faces its projection crosses (Appendix A), remove those faces (the
+//! "clear-out region"), insert the edge u–w and fill the two polygons on either side by greedy
+//! smallest-angle ear cutting (Fig. 3.3). The face count of the region is unchanged.
+//!
+//! Differences from the thesis, each fixing a failure it leaves open:
+//! - The projection is a *cutting plane* through u and w containing the mean surface normal, with
+//!   the side of every vertex decided once from its signed distance. The walk is therefore
+//!   consistent across faces and cannot lose its way when the path runs through a vertex.
+//! - A crossing within `snap_fraction` of an edge length from a free vertex snaps that vertex
+//!   onto the segment and makes it a chain vertex (instead of creating a sliver triangle).
+//! - When the walk fails (mesh boundary, crossing another curve's edge, no valid re-triangulation)
+//!   the fallback of §3.2 runs: a Dijkstra path between the ends, its inner vertices moved onto
+//!   the segment.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashSet};
+use std::hash::BuildHasherDefault;
+
+use crate::error::Result;
+use crate::geometry::{add, cross, dot, norm, normalize, scale, sub};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+use super::curves::CurveNetwork;
+use super::trimesh::{IntHasher, IntMap, TriMesh};
+
+type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
+
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct RetriStats {
+    pub segments: usize,
+    /// Segments that were mesh edges already.
+    pub already_edges: usize,
+    /// Segments realised by walk + re-triangulation (possibly in several snapped pieces).
+    pub walked: usize,
+    /// Free mesh vertices snapped onto a segment (they become chain vertices).
+    pub snapped_vertices: usize,
+    /// Segments that needed the Dijkstra-and-project fallback.
+    pub fallback_segments: usize,
+    /// Vertices the fallback moved onto a segment.
+    pub fallback_moved_vertices: usize,
+    /// Segments that could not be realised at all.
+    pub failed_segments: usize,
+}
+
+pub struct Realised {
+    /// Per network segment: the mesh vertex chain from `segments[i][0]`'s vertex to `[1]`'s.
+    pub chains: Vec<Vec<u32>>,
+    /// Vertices on some chain (curve vertices and those added to chains).
+    pub on_curve: Vec<bool>,
+    pub stats: RetriStats,
+}
+
+/// The plane through the segment that contains the mean surface normal.
+struct Cut {
+    a: Point3,
+    dir: Point3,
+    side: Point3,
+    len: f64,
+}
+
+impl Cut {
+    fn s(&self, p: Point3) -> f64 {
+        dot(sub(p, self.a), self.side)
+    }
+    fn t(&self, p: Point3) -> f64 {
+        dot(sub(p, self.a), self.dir)
+    }
+    fn on_line(&self, p: Point3) -> Point3 {
+        add(self.a, scale(self.dir, self.t(p).clamp(0.0, self.len)))
+    }
+}
+
+enum Walk {
+    /// u–w is an edge already.
+    Edge,
+    /// Snap this neighbour of the start vertex (no face crossed).
+    SnapAtStart(u32),
+    /// Faces crossed and the (left, right) edges between them, ending at `end` (w, or a vertex to snap).
+    Strip { faces: Vec<u32>, crossed: Vec<(u32, u32)>, end: u32 },
+    Fail,
+}
+
+pub fn realise(
+    mesh: &mut TriMesh,
+    net: &CurveNetwork,
+    vertex_of_point: &[u32],
+    snap_fraction: f64,
+    progress: &Progress,
+) -> Result<Realised> {
+    let mut on_curve = vec![false; mesh.pos.len()];
+    for &v in vertex_of_point {
+        on_curve[v as usize] = true;
+    }
+    let mut locked_edges = EdgeSet::default();
+    let mut stats = RetriStats { segments: net.segments.len(), ..Default::default() };
+    let mut chains = Vec::with_capacity(net.segments.len());
+    for (si, seg) in net.segments.iter().enumerate() {
+        if si % 256 == 0 {
+            progress.fraction(si as f64 / net.segments.len().max(1) as f64)?;
+        }
+        let (u, w) = (vertex_of_point[seg[0] as usize], vertex_of_point[seg[1] as usize]);
+        let mut chain = vec![u];
+        if mesh.has_edge(u, w) {
+            stats.already_edges += 1;
+            chain.push(w);
+        } else {
+            let ok = walk_segment(mesh, u, w, snap_fraction, &mut on_curve, &locked_edges, &mut chain, &mut stats);
+            if ok {
+                stats.walked += 1;
+            } else {
+                // Fallback from wherever the walk stopped.
+                let from = *chain.last().unwrap_or(&u);
+                match dijkstra_project(mesh, from, w, &on_curve) {
+                    Some(path) => {
+                        stats.fallback_segments += 1;
+                        stats.fallback_moved_vertices += path.len().saturating_sub(2);
+                        for &v in &path[1..] {
+                            on_curve[v as usize] = true;
+                            chain.push(v);
+                        }
+                    }
+                    None => {
+                        stats.failed_segments += 1;
+                        chain.push(w);
+                    }
+                }
+            }
+        }
+        for p in chain.windows(2) {
+            locked_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
+        }
+        chains.push(chain);
+    }
+    Ok(Realised { chains, on_curve, stats })
+}
+
+/// Walks and re-triangulates from u to w, possibly in pieces at snapped vertices. Pushes chain
+/// vertices after u; returns false when the fallback is needed (from the last chain vertex).
+#[allow(clippy::too_many_arguments)]
+fn walk_segment(
+    mesh: &mut TriMesh,
+    u: u32,
+    w: u32,
+    snap_fraction: f64,
+    on_curve: &mut [bool],
+    locked_edges: &EdgeSet,
+    chain: &mut Vec<u32>,
+    stats: &mut RetriStats,
+) -> bool {
+    let (a, b) = (mesh.pos[u as usize], mesh.pos[w as usize]);
+    let d = sub(b, a);
+    let len = norm(d);
+    if len == 0.0 {
+        return false;
+    }
+    let dir = scale(d, 1.0 / len);
+    let n = add(mesh.vertex_normal(u), mesh.vertex_normal(w));
+    let n = normalize(sub(n, scale(dir, dot(n, dir))));
+    if n == [0.0; 3] {
+        return false;
+    }
+    let cut = Cut { a, dir, side: cross(n, dir), len };
+    let mut cur = u;
+    for _piece in 0..10_000 {
+        match walk(mesh, &cut, cur, w, snap_fraction, on_curve, locked_edges) {
+            Walk::Edge => {
+                chain.push(w);
+                return true;
+            }
+            Walk::SnapAtStart(z) => {
+                mesh.pos[z as usize] = cut.on_line(mesh.pos[z as usize]);
+                on_curve[z as usize] = true;
+                stats.snapped_vertices += 1;
+                chain.push(z);
+                cur = z;
+            }
+            Walk::Strip { faces, crossed, end } => {
+                let old = mesh.pos[end as usize];
+                if end != w {
+                    mesh.pos[end as usize] = cut.on_line(old);
+                }
+                if !retriangulate(mesh, cur, end, &faces, &crossed) {
+                    mesh.pos[end as usize] = old;
+                    return false;
+                }
+                chain.push(end);
+                if end == w {
+                    return true;
+                }
+                on_curve[end as usize] = true;
+                stats.snapped_vertices += 1;
+                cur = end;
+            }
+            Walk::Fail => return false,
+        }
+    }
+    false
+}
+
+/// Can `z` move onto the cut line without flipping a face of its star?
+fn snappable(mesh: &TriMesh, cut: &Cut, z: u32, on_curve: &[bool]) -> bool {
+    if on_curve[z as usize] || mesh.is_boundary_vertex(z) {
+        return false;
+    }
+    let target = cut.on_line(mesh.pos[z as usize]);
+    let tz = cut.t(mesh.pos[z as usize]);
+    if tz <= 0.0 || tz >= cut.len {
+        return false;
+    }
+    mesh.faces_of(z).iter().all(|&f| {
+        let t = mesh.tris[f as usize];
+        let p = |v: u32| if v == z { target } else { mesh.pos[v as usize] };
+        let n0 = mesh.face_normal(f);
+        let n1 = cross(sub(p(t[1]), p(t[0])), sub(p(t[2]), p(t[0])));
+        dot(n0, n1) > 0.0 && norm(n1) > 1e-12 * norm(n0)
+    })
+}
+
+fn walk(
+    mesh: &TriMesh,
+    cut: &Cut,
+    from: u32,
+    to: u32,
+    snap: f64,
+    on_curve: &[bool],
+    locked_edges: &EdgeSet,
+) -> Walk {
+    if mesh.has_edge(from, to) {
+        return Walk::Edge;
+    }
+    let s = |v: u32| cut.s(mesh.pos[v as usize]);
+    let pf = mesh.pos[from as usize];
+    let t_end = cut.t(mesh.pos[to as usize]);
+    // Start: the face of `from`'s star whose opposite edge the forward ray crosses.
+    let mut best: Option<(u32, u32, u32, f64)> = None; // face, left, right, forwardness
+    for &f in mesh.faces_of(from) {
+        let t = mesh.tris[f as usize];
+        let k = t.iter().position(|&v| v == from).unwrap_or(0);
+        let (x, y) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+        let (sx, sy) = (s(x), s(y));
+        if (sx >= 0.0) == (sy >= 0.0) {
+            continue;
+        }
+        let (l, r) = if sx >= 0.0 { (x, y) } else { (y, x) };
+        let c = crossing(mesh, cut, l, r).0;
+        let fwd = dot(normalize(sub(c, pf)), cut.dir);
+        if fwd > 0.0 && best.is_none_or(|b| fwd > b.3) {
+            best = Some((f, l, r, fwd));
+        }
+    }
+    let Some((f0, mut l, mut r, _)) = best else { return Walk::Fail };
+    let (_, lam) = crossing(mesh, cut, l, r);
+    for (v, near) in [(l, lam < snap), (r, 1.0 - lam < snap)] {
+        if near && cut.t(mesh.pos[v as usize]) < t_end && snappable(mesh, cut, v, on_curve) {
+            return Walk::SnapAtStart(v);
+        }
+    }
+    let locked = |a: u32, b: u32| locked_edges.contains(&(a.min(b), a.max(b)));
+    if locked(l, r) {
+        return Walk::Fail;
+    }
+    let mut faces = vec![f0];
+    let mut crossed = vec![(l, r)];
+    let mut seen: HashSet<u32, BuildHasherDefault<IntHasher>> = HashSet::default();
+    seen.insert(f0);
+    let mut cur = f0;
+    for _step in 0..mesh.tris.len().min(1_000_000) {
+        let Some(g) = mesh.across(cur, l, r) else { return Walk::Fail };
+        if !seen.insert(g) {
+            return Walk::Fail;
+        }
+        let t = mesh.tris[g as usize];
+        let Some(&z) = t.iter().find(|&&v| v != l && v != r) else { return Walk::Fail };
+        faces.push(g);
+        if z == to {
+            return Walk::Strip { faces, crossed, end: to };
+        }
+        let z_left = s(z) >= 0.0;
+        let (nl, nr) = if z_left { (z, r) } else { (l, z) };
+        let (c, lam) = crossing(mesh, cut, nl, nr);
+        if cut.t(c) > t_end + 0.25 * cut.len {
+            return Walk::Fail; // passed the end without meeting it
+        }
+        let near_z = if z_left { lam < snap } else { 1.0 - lam < snap };
+        if near_z && cut.t(mesh.pos[z as usize]) < t_end && snappable(mesh, cut, z, on_curve) {
+            return Walk::Strip { faces, crossed, end: z };
+        }
+        if locked(nl, nr) {
+            return Walk::Fail;
+        }
+        crossed.push((nl, nr));
+        (l, r, cur) = (nl, nr, g);
+    }
+    Walk::Fail
+}
+
+/// Where the cut plane crosses edge (l, r) (s(l) ≥ 0 > s(r)): the point and its parameter from l.
+fn crossing(mesh: &TriMesh, cut: &Cut, l: u32, r: u32) -> (Point3, f64) {
+    let (pl, pr) = (mesh.pos[l as usize], mesh.pos[r as usize]);
+    let (sl, sr) = (cut.s(pl), cut.s(pr));
+    let lam = if sl - sr > 0.0 { (sl / (sl - sr)).clamp(0.0, 1.0) } else { 0.5 };
+    (add(pl, scale(sub(pr, pl), lam)), lam)
+}
+
+/// Replaces the strip `faces` between u and `end` by the edge u–end and an ear-cut filling of the
+/// polygons on either side. On failure the mesh is left as it was.
+fn retriangulate(mesh: &mut TriMesh, u: u32, end: u32, faces: &[u32], crossed: &[(u32, u32)]) -> bool {
+    let mut left: Vec<u32> = Vec::new();
+    let mut right: Vec<u32> = Vec::new();
+    for &(l, r) in crossed {
+        if left.last() != Some(&l) {
+            left.push(l);
+        }
+        if right.last() != Some(&r) {
+            right.push(r);
+        }
+    }
+    let mut all: Vec<u32> = left.iter().chain(&right).copied().collect();
+    all.push(u);
+    all.push(end);
+    let n_all = all.len();
+    all.sort_unstable();
+    all.dedup();
+    if all.len() != n_all || mesh.has_edge(u, end) {
+        return false; // the strip wraps around a vertex: not a simple region
+    }
+    let mut nr = [0.0; 3];
+    for &f in faces {
+        nr = add(nr, mesh.face_normal(f));
+    }
+    let nr = normalize(nr);
+    let e1 = normalize(sub(mesh.pos[end as usize], mesh.pos[u as usize]));
+    let e1 = normalize(sub(e1, scale(nr, dot(e1, nr))));
+    let e2 = cross(nr, e1);
+    if e1 == [0.0; 3] || nr == [0.0; 3] {
+        return false;
+    }
+    let mut left_poly = vec![u, end];
+    left_poly.extend(left.iter().rev());
+    let mut right_poly = vec![end, u];
+    right_poly.extend(right.iter());
+    let saved: Vec<[u32; 3]> = faces.iter().map(|&f| mesh.tris[f as usize]).collect();
+    for &f in faces {
+        mesh.remove_face(f);
+    }
+    let origin = mesh.pos[u as usize];
+    let new = ear_cut(mesh, &left_poly, origin, e1, e2)
+        .and_then(|mut a| ear_cut(mesh, &right_poly, origin, e1, e2).map(|b| { a.extend(b); a }));
+    let mut added = Vec::new();
+    let ok = match new {
+        Some(tris) if tris.len() == faces.len() => {
+            let mut ok = true;
+            for t in tris {
+                match mesh.add_face(t) {
+                    Ok(f) => added.push(f),
+                    Err(()) => {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            ok
+        }
+        _ => false,
+    };
+    if !ok {
+        for f in added {
+            mesh.remove_face(f);
+        }
+        for t in saved {
+            let _ = mesh.add_face(t);
+        }
+    }
+    ok
+}
+
+/// Greedy ear cutting of a CCW polygon (in the e1/e2 frame), smallest angle first (Fig. 3.3).
+/// Refuses ears whose new diagonal already exists as a mesh edge.
+fn ear_cut(mesh: &TriMesh, poly: &[u32], origin: Point3, e1: Point3, e2: Point3) -> Option<Vec<[u32; 3]>> {
+    let p2: Vec<[f64; 2]> = poly
+        .iter()
+        .map(|&v| {
+            let d = sub(mesh.pos[v as usize], origin);
+            [dot(d, e1), dot(d, e2)]
+        })
+        .collect();
+    let scale2 = p2.iter().fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())).powi(2).max(1e-300);
+    let mut idx: Vec<usize> = (0..poly.len()).collect();
+    let mut out = Vec::with_capacity(poly.len().saturating_sub(2));
+    let mut diagonals: IntMap<(u32, u32), ()> = IntMap::default();
+    let cross2 = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    while idx.len() > 3 {
+        let n = idx.len();
+        let mut best: Option<(usize, f64)> = None;
+        for k in 0..n {
+            let (ip, ic, inx) = (idx[(k + n - 1) % n], idx[k], idx[(k + 1) % n]);
+            let (pp, pc, pn) = (p2[ip], p2[ic], p2[inx]);
+            let area = cross2(pp, pc, pn);
+            if area <= 1e-12 * scale2 {
+                continue; // reflex or flat corner
+            }
+            let inside = idx.iter().any(|&j| {
+                j != ip && j != ic && j != inx && {
+                    let q = p2[j];
+                    cross2(pp, pc, q) >= 0.0 && cross2(pc, pn, q) >= 0.0 && cross2(pn, pp, q) >= 0.0
+                }
+            });
+            if inside {
+                continue;
+            }
+            let (vp, vn) = (poly[ip], poly[inx]);
+            if mesh.has_edge(vp, vn) || diagonals.contains_key(&(vp.min(vn), vp.max(vn))) {
+                continue;
+            }
+            let u = [pp[0] - pc[0], pp[1] - pc[1]];
+            let v = [pn[0] - pc[0], pn[1] - pc[1]];
+            let angle = (u[0] * v[1] - u[1] * v[0]).abs().atan2(u[0] * v[0] + u[1] * v[1]);
+            if best.is_none_or(|b| angle < b.1) {
+                best = Some((k, angle));
+            }
+        }
+        let (k, _) = best?;
+        let (ip, ic, inx) = (idx[(k + n - 1) % n], idx[k], idx[(k + 1) % n]);
+        out.push([poly[ip], poly[ic], poly[inx]]);
+        diagonals.insert((poly[ip].min(poly[inx]), poly[ip].max(poly[inx])), ());
+        idx.remove(k);
+    }
+    if idx.len() == 3 {
+        if cross2(p2[idx[0]], p2[idx[1]], p2[idx[2]]) <= 0.0 {
+            return None;
+        }
+        out.push([poly[idx[0]], poly[idx[1]], poly[idx[2]]]);
+    }
+    Some(out)
+}
+
+/// §3.2 fallback: shortest edge path from `from` to `to` through free vertices, whose inner
+/// vertices are then moved onto the segment (spaced by their arc length along the path).
+fn dijkstra_project(mesh: &mut TriMesh, from: u32, to: u32, on_curve: &[bool]) -> Option<Vec<u32>> {
+    let mut dist: IntMap<u32, f64> = IntMap::default();
+    let mut prev: IntMap<u32, u32> = IntMap::default();
+    let mut heap = BinaryHeap::new();
+    dist.insert(from, 0.0);
+    heap.push(Reverse((0u64, from)));
+    let mut pops = 0usize;
+    while let Some(Reverse((dbits, v))) = heap.pop() {
+        let dv = f64::from_bits(dbits);
+        if dv > *dist.get(&v).unwrap_or(&f64::INFINITY) {
+            continue;
+        }
+        if v == to {
+            break;
+        }
+        pops += 1;
+        if pops > 2_000_000 {
+            return None;
+        }
+        for &f in mesh.faces_of(v) {
+            for &nb in &mesh.tris[f as usize] {
+                if nb == v || (nb != to && on_curve[nb as usize]) {
+                    continue;
+                }
+                let nd = dv + mesh.len(v, nb);
+                if nd < *dist.get(&nb).unwrap_or(&f64::INFINITY) {
+                    dist.insert(nb, nd);
+                    prev.insert(nb, v);
+                    // Non-negative f64 bit patterns order like the values.
+                    heap.push(Reverse((nd.to_bits(), nb)));
+                }
+            }
+        }
+    }
+    let total = *dist.get(&to)?;
+    let mut path = vec![to];
+    let mut v = to;
+    while v != from {
+        v = *prev.get(&v)?;
+        path.push(v);
+    }
+    path.reverse();
+    let (a, b) = (mesh.pos[from as usize], mesh.pos[to as usize]);
+    let mut acc = 0.0;
+    let old: Vec<Point3> = path.iter().map(|&v| mesh.pos[v as usize]).collect();
+    for k in 1..path.len().saturating_sub(1) {
+        acc += crate::geometry::dist(old[k - 1], old[k]);
+        let frac = if total > 0.0 { acc / total } else { 0.5 };
+        mesh.pos[path[k] as usize] = add(a, scale(sub(b, a), frac));
+    }
+    Some(path)
+}

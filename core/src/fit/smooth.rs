@@ -1,0 +1,224 @@
+//! Smoothing (Ch. 4), with the curve vertices (and the mesh boundary) held fixed (§4.3.3).
+//!
+//! 1. Modified mean-curvature flow (4.9, with its projection typo corrected): each free vertex
+//!    moves by the *tangential* part of a cotangent-weighted Laplacian step and is dropped back
+//!    onto the plane of the nearest face of the current surface. The step is scale-free: a
+//!    fraction `mcf_step` of the way to the cotangent-weighted mean of the ring (λ of (4.7)
+//!    normalised by the weights, so results do not depend on model units).
+//! 2. Modified Laplacian flow (4.11, read as the note suggests): a tangential uniform-Laplacian
+//!    step from the current position, then back-projection onto the surface *as it was before
+//!    smoothing* (closest point, found by a local walk over the reference faces, which keeps the
+//!    O(faces) per iteration of §4.3.4).
+
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+pub struct SmoothSettings {
+    pub mcf_iterations: u32,
+    pub mcf_step: f64,
+    pub laplacian_iterations: u32,
+}
+
+/// Compressed vertex → neighbours and vertex → faces.
+struct Rings {
+    nb_off: Vec<u32>,
+    nb: Vec<u32>,
+    vf_off: Vec<u32>,
+    vf: Vec<u32>,
+}
+
+fn rings(nv: usize, tris: &[[u32; 3]]) -> Rings {
+    let mut vf_cnt = vec![0u32; nv + 1];
+    for t in tris {
+        for &v in t {
+            vf_cnt[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..nv {
+        vf_cnt[i + 1] += vf_cnt[i];
+    }
+    let mut vf = vec![0u32; vf_cnt[nv] as usize];
+    let mut fill = vf_cnt.clone();
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            vf[fill[v as usize] as usize] = f as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let mut nb_off = vec![0u32; nv + 1];
+    let mut nb = Vec::with_capacity(vf.len());
+    for v in 0..nv {
+        let start = nb.len();
+        for &f in &vf[vf_cnt[v] as usize..vf_cnt[v + 1] as usize] {
+            for &w in &tris[f as usize] {
+                if w as usize != v && !nb[start..].contains(&w) {
+                    nb.push(w);
+                }
+            }
+        }
+        nb_off[v + 1] = nb.len() as u32;
+    }
+    Rings { nb_off, nb, vf_off: vf_cnt, vf }
+}
+
+fn face_normal(pos: &[Point3], t: [u32; 3]) -> Point3 {
+    cross(sub(pos[t[1] as usize], pos[t[0] as usize]), sub(pos[t[2] as usize], pos[t[0] as usize]))
+}
+
+/// Smooths `pos` in place; `fixed[v]` vertices never move.
+pub fn smooth(pos: &mut [Point3], tris: &[[u32; 3]], fixed: &[bool], s: &SmoothSettings, progress: &Progress) -> Result<()> {
+    let nv = pos.len();
+    let r = rings(nv, tris);
+    let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
+    // Stage 1: modified mean-curvature flow.
+    for it in 0..s.mcf_iterations {
+        progress.fraction(it as f64 / total)?;
+        // Cotangent weights per vertex pair, accumulated face by face.
+        let mut acc = vec![[0.0f64; 4]; nv]; // Σ w·q (3) and Σ w
+        for t in tris {
+            for k in 0..3 {
+                let (i, j, o) = (t[k] as usize, t[(k + 1) % 3] as usize, t[(k + 2) % 3] as usize);
+                let (u, v) = (sub(pos[i], pos[o]), sub(pos[j], pos[o]));
+                let cr = norm2(cross(u, v)).sqrt();
+                if cr <= 0.0 {
+                    continue;
+                }
+                // Negative cotangents (obtuse corners) are clamped: they make the step leave the ring.
+                let w = (dot(u, v) / cr).max(0.0) * 0.5;
+                for (a, b) in [(i, j), (j, i)] {
+                    acc[a][0] += w * pos[b][0];
+                    acc[a][1] += w * pos[b][1];
+                    acc[a][2] += w * pos[b][2];
+                    acc[a][3] += w;
+                }
+            }
+        }
+        let old = pos.to_vec();
+        pos.par_iter_mut().enumerate().for_each(|(v, p)| {
+            if fixed[v] || acc[v][3] <= 0.0 {
+                return;
+            }
+            let target = scale([acc[v][0], acc[v][1], acc[v][2]], 1.0 / acc[v][3]);
+            let faces = &r.vf[r.vf_off[v] as usize..r.vf_off[v + 1] as usize];
+            let mut n = [0.0; 3];
+            for &f in faces {
+                n = add(n, face_normal(&old, tris[f as usize]));
+            }
+            let n = normalize(n);
+            let d = scale(sub(target, old[v]), s.mcf_step);
+            let moved = add(old[v], sub(d, scale(n, dot(d, n))));
+            // Drop back onto the plane of the nearest incident face (current surface).
+            let best = faces.iter().min_by(|&&a, &&b| {
+                let ca = centroid(&old, tris[a as usize]);
+                let cb = centroid(&old, tris[b as usize]);
+                norm2(sub(ca, moved)).total_cmp(&norm2(sub(cb, moved)))
+            });
+            *p = match best {
+                Some(&f) => {
+                    let fnorm = normalize(face_normal(&old, tris[f as usize]));
+                    let o = old[tris[f as usize][0] as usize];
+                    sub(moved, scale(fnorm, dot(sub(moved, o), fnorm)))
+                }
+                None => moved,
+            };
+        });
+    }
+    // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
+    let reference = pos.to_vec();
+    let mut ref_face: Vec<u32> =
+        (0..nv).map(|v| if r.vf_off[v] < r.vf_off[v + 1] { r.vf[r.vf_off[v] as usize] } else { u32::MAX }).collect();
+    for it in 0..s.laplacian_iterations {
+        progress.fraction((s.mcf_iterations + it) as f64 / total)?;
+        let old = pos.to_vec();
+        pos.par_iter_mut().zip(ref_face.par_iter_mut()).enumerate().for_each(|(v, (p, rf))| {
+            let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
+            if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
+                return;
+            }
+            let mut m = [0.0; 3];
+            for &w in nbs {
+                m = add(m, old[w as usize]);
+            }
+            let m = scale(m, 1.0 / nbs.len() as f64);
+            let n = normalize(face_normal(&reference, tris[*rf as usize]));
+            let d = sub(m, old[v]);
+            let moved = add(old[v], sub(d, scale(n, dot(d, n))));
+            let (f, q) = closest_by_walk(&reference, tris, &r, *rf, moved);
+            *rf = f;
+            *p = q;
+        });
+    }
+    Ok(())
+}
+
+fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
+    scale(add(add(pos[t[0] as usize], pos[t[1] as usize]), pos[t[2] as usize]), 1.0 / 3.0)
+}
+
+/// Closest point on the reference surface near face `start`: greedy walk over faces sharing a
+/// vertex with the current best until no neighbour is closer (bounded steps).
+fn closest_by_walk(pos: &[Point3], tris: &[[u32; 3]], r: &Rings, start: u32, p: Point3) -> (u32, Point3) {
+    let mut best_f = start;
+    let mut best_q = closest_on_triangle(p, tris[start as usize], pos);
+    let mut best_d = norm2(sub(best_q, p));
+    for _ in 0..16 {
+        let mut improved = false;
+        let t = tris[best_f as usize];
+        for &v in &t {
+            for &g in &r.vf[r.vf_off[v as usize] as usize..r.vf_off[v as usize + 1] as usize] {
+                if g == best_f {
+                    continue;
+                }
+                let q = closest_on_triangle(p, tris[g as usize], pos);
+                let d = norm2(sub(q, p));
+                if d < best_d * (1.0 - 1e-12) {
+                    (best_f, best_q, best_d, improved) = (g, q, d, true);
+                }
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    (best_f, best_q)
+}
+
+/// Closest point on triangle `t` to `p` (Ericson, Real-Time Collision Detection §5.1.5).
+pub fn closest_on_triangle(p: Point3, t: [u32; 3], pos: &[Point3]) -> Point3 {
+    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+    let ab = sub(b, a);
+    let ac = sub(c, a);
+    let ap = sub(p, a);
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return add(a, scale(ab, d1 / (d1 - d3)));
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return add(a, scale(ac, d2 / (d2 - d6)));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)))
+}

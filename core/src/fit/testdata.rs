@@ -1,0 +1,128 @@
+//! Curve networks with a known truth, for the fit tests and the benchmark: they are built from
+//! analytic surfaces or exact plane sections, never from the code under test.
+
+use std::collections::HashMap;
+
+use crate::geometry::{add, dot, scale, sub};
+use crate::mesh::{Mesh, Point3};
+
+/// The three principal-plane sections of the ellipsoid x²/a² + y²/b² + z²/c² = 1, each sampled at
+/// `per_quadrant` points per quarter so that the six axis points are shared: 6 feature points of
+/// degree 4, 12 arcs, 8 regions (the octants).
+pub fn ellipsoid_sections(axes: [f64; 3], per_quadrant: usize) -> Mesh {
+    let mut positions: Vec<Point3> = Vec::new();
+    let mut index: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut id = |p: Point3, positions: &mut Vec<Point3>| -> u32 {
+        let key = [(p[0] * 1e9).round() as i64, (p[1] * 1e9).round() as i64, (p[2] * 1e9).round() as i64];
+        *index.entry(key).or_insert_with(|| {
+            positions.push(p);
+            (positions.len() - 1) as u32
+        })
+    };
+    let mut curves = Vec::new();
+    for (i, j) in [(0usize, 1usize), (1, 2), (2, 0)] {
+        let n = 4 * per_quadrant;
+        let mut line = Vec::with_capacity(n + 1);
+        for k in 0..=n {
+            let th = std::f64::consts::TAU * k as f64 / n as f64;
+            // Exact zeros at the quadrant points so the shared vertices coincide.
+            let (c, s) = match k % per_quadrant {
+                0 => [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)][(k / per_quadrant) % 4],
+                _ => (th.cos(), th.sin()),
+            };
+            let mut p = [0.0; 3];
+            p[i] = axes[i] * c;
+            p[j] = axes[j] * s;
+            line.push(id(p, &mut positions));
+        }
+        curves.push(line);
+    }
+    Mesh { positions, curves, ..Default::default() }
+}
+
+/// Approximate distance of `p` to the ellipsoid (first-order: |F| / |∇F| with
+/// F = Σ (x_k / a_k)² − 1), accurate for points near the surface.
+pub fn ellipsoid_distance(p: Point3, axes: [f64; 3]) -> f64 {
+    let f: f64 = (0..3).map(|k| (p[k] / axes[k]).powi(2)).sum::<f64>() - 1.0;
+    let g = [2.0 * p[0] / axes[0].powi(2), 2.0 * p[1] / axes[1].powi(2), 2.0 * p[2] / axes[2].powi(2)];
+    f.abs() / dot(g, g).sqrt().max(1e-300)
+}
+
+/// Sections of a triangle mesh by planes `dot(normal, x) = offset`, returned as a curve network of
+/// two-point lines whose vertices are shared where polylines meet: each section point lies on a
+/// mesh edge; where two sections cross inside a triangle, the crossing point is inserted in both.
+/// Apply a map to the positions afterwards (e.g. a known deformation) to move the curves with it.
+pub fn plane_sections(mesh: &Mesh, planes: &[(Point3, f64)]) -> Mesh {
+    let tris = crate::shapes::fan_triangles(&mesh.faces);
+    let pos = &mesh.positions;
+    let mut positions: Vec<Point3> = Vec::new();
+    let mut edge_point: HashMap<(usize, u32, u32), u32> = HashMap::new();
+    let mut curves: Vec<Vec<u32>> = Vec::new();
+    let side = |pl: usize, v: u32| dot(planes[pl].0, pos[v as usize]) - planes[pl].1;
+    for t in &tris {
+        // The section segment of each plane through this triangle.
+        let mut segs: Vec<(usize, [u32; 2], [Point3; 2])> = Vec::new();
+        for pl in 0..planes.len() {
+            let mut ends = Vec::new();
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (sa, sb) = (side(pl, a), side(pl, b));
+                if (sa >= 0.0) != (sb >= 0.0) {
+                    let key = (pl, a.min(b), a.max(b));
+                    let lam = sa / (sa - sb);
+                    let p = add(pos[a as usize], scale(sub(pos[b as usize], pos[a as usize]), lam));
+                    let id = *edge_point.entry(key).or_insert_with(|| {
+                        positions.push(p);
+                        (positions.len() - 1) as u32
+                    });
+                    ends.push((id, p));
+                }
+            }
+            if ends.len() == 2 {
+                segs.push((pl, [ends[0].0, ends[1].0], [ends[0].1, ends[1].1]));
+            }
+        }
+        // Crossings of two sections inside this triangle split both segments.
+        let mut splits: Vec<Vec<(f64, u32)>> = vec![Vec::new(); segs.len()];
+        for i in 0..segs.len() {
+            for j in i + 1..segs.len() {
+                let (pi, pj) = (segs[i].2, segs[j].2);
+                let (pl_j, pl_i) = (segs[j].0, segs[i].0);
+                let s0 = dot(planes[pl_j].0, pi[0]) - planes[pl_j].1;
+                let s1 = dot(planes[pl_j].0, pi[1]) - planes[pl_j].1;
+                if (s0 >= 0.0) == (s1 >= 0.0) {
+                    continue;
+                }
+                let lam = s0 / (s0 - s1);
+                let x = add(pi[0], scale(sub(pi[1], pi[0]), lam));
+                let r0 = dot(planes[pl_i].0, pj[0]) - planes[pl_i].1;
+                let r1 = dot(planes[pl_i].0, pj[1]) - planes[pl_i].1;
+                if (r0 >= 0.0) == (r1 >= 0.0) {
+                    continue;
+                }
+                let mu = r0 / (r0 - r1);
+                positions.push(x);
+                let id = (positions.len() - 1) as u32;
+                splits[i].push((lam, id));
+                splits[j].push((mu, id));
+            }
+        }
+        for (k, (_, ends, _)) in segs.iter().enumerate() {
+            let mut pts = vec![(0.0, ends[0])];
+            pts.extend(splits[k].iter().copied());
+            pts.push((1.0, ends[1]));
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for w in pts.windows(2) {
+                curves.push(vec![w[0].1, w[1].1]);
+            }
+        }
+    }
+    Mesh { positions, curves, ..Default::default() }
+}
+
+/// A smooth, non-affine, orientation-preserving deformation used to make targets with a known
+/// truth: an anisotropic scale, a bend about the y axis and a shift.
+pub fn bend(p: Point3, size: f64) -> Point3 {
+    let (x, y, z) = (p[0] / size, p[1] / size, p[2] / size);
+    [size * (1.1 * x + 0.08 * y * y), size * (0.95 * y + 0.05 * (2.0 * x).sin()), size * (1.05 * z + 0.06 * x * x)]
+}

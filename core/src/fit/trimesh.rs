@@ -1,0 +1,163 @@
+//! A small editable triangle mesh with directed-edge → face lookup and vertex → face lists: what
+//! the flip subdivision, the segment walk and the re-triangulation need (faces are removed and
+//! added one at a time). Requires an oriented edge-manifold input, which it checks.
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, normalize, sub, triangle_cross};
+use crate::mesh::Point3;
+
+/// Multiplicative hash for small integer keys (the std SipHash costs more than the work here).
+#[derive(Default)]
+pub struct IntHasher(u64);
+
+impl Hasher for IntHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(26) ^ i).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 29)
+    }
+}
+
+pub type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
+
+pub struct TriMesh {
+    pub pos: Vec<Point3>,
+    pub tris: Vec<[u32; 3]>,
+    pub alive: Vec<bool>,
+    half: IntMap<(u32, u32), u32>,
+    vfaces: Vec<Vec<u32>>,
+}
+
+impl TriMesh {
+    /// Builds the adjacency; fails naming the face when an edge is used twice in one direction
+    /// (non-manifold or inconsistently oriented input).
+    pub fn new(pos: Vec<Point3>, tris: Vec<[u32; 3]>) -> Result<Self> {
+        let mut m = TriMesh {
+            vfaces: vec![Vec::new(); pos.len()],
+            pos,
+            alive: vec![true; tris.len()],
+            half: IntMap::with_capacity_and_hasher(tris.len() * 3, Default::default()),
+            tris: Vec::with_capacity(tris.len()),
+        };
+        for (fi, t) in tris.iter().enumerate() {
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return Err(Error::Topology(format!("template face {fi} repeats a vertex {t:?}")));
+            }
+            for k in 0..3 {
+                if let Some(other) = m.half.insert((t[k], t[(k + 1) % 3]), fi as u32) {
+                    return Err(Error::Topology(format!(
+                        "template edge ({}, {}) is used in the same direction by faces {other} and {fi}: \
+                         the template is not an oriented manifold (run the repair job first)",
+                        t[k],
+                        t[(k + 1) % 3]
+                    )));
+                }
+                m.vfaces[t[k] as usize].push(fi as u32);
+            }
+            m.tris.push(*t);
+        }
+        Ok(m)
+    }
+
+    pub fn add_vertex(&mut self, p: Point3) -> u32 {
+        self.pos.push(p);
+        self.vfaces.push(Vec::new());
+        (self.pos.len() - 1) as u32
+    }
+
+    /// Adds a face; Err(()) if one of its directed edges is already taken.
+    pub fn add_face(&mut self, t: [u32; 3]) -> std::result::Result<u32, ()> {
+        for k in 0..3 {
+            if self.half.contains_key(&(t[k], t[(k + 1) % 3])) {
+                return Err(());
+            }
+        }
+        let fi = self.tris.len() as u32;
+        for k in 0..3 {
+            self.half.insert((t[k], t[(k + 1) % 3]), fi);
+            self.vfaces[t[k] as usize].push(fi);
+        }
+        self.tris.push(t);
+        self.alive.push(true);
+        Ok(fi)
+    }
+
+    pub fn remove_face(&mut self, f: u32) {
+        if !self.alive[f as usize] {
+            return;
+        }
+        let t = self.tris[f as usize];
+        self.alive[f as usize] = false;
+        for k in 0..3 {
+            self.half.remove(&(t[k], t[(k + 1) % 3]));
+            let list = &mut self.vfaces[t[k] as usize];
+            if let Some(i) = list.iter().position(|&g| g == f) {
+                list.swap_remove(i);
+            }
+        }
+    }
+
+    pub fn faces_of(&self, v: u32) -> &[u32] {
+        &self.vfaces[v as usize]
+    }
+
+    pub fn has_edge(&self, a: u32, b: u32) -> bool {
+        self.half.contains_key(&(a, b)) || self.half.contains_key(&(b, a))
+    }
+
+    /// The face on the other side of edge (a, b) from face `f`.
+    pub fn across(&self, f: u32, a: u32, b: u32) -> Option<u32> {
+        [self.half.get(&(a, b)), self.half.get(&(b, a))].into_iter().flatten().copied().find(|&g| g != f)
+    }
+
+    /// True when some edge at `v` has a face on one side only.
+    pub fn is_boundary_vertex(&self, v: u32) -> bool {
+        self.vfaces[v as usize].iter().any(|&f| {
+            let t = self.tris[f as usize];
+            (0..3).any(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                (a == v || b == v) && !self.half.contains_key(&(b, a))
+            })
+        })
+    }
+
+    pub fn face_normal(&self, f: u32) -> Point3 {
+        let t = self.tris[f as usize];
+        triangle_cross(self.pos[t[0] as usize], self.pos[t[1] as usize], self.pos[t[2] as usize])
+    }
+
+    /// Area-weighted unit vertex normal.
+    pub fn vertex_normal(&self, v: u32) -> Point3 {
+        let mut n = [0.0; 3];
+        for &f in &self.vfaces[v as usize] {
+            n = add(n, self.face_normal(f));
+        }
+        normalize(n)
+    }
+
+    pub fn alive_faces(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tris.len() as u32).filter(move |&f| self.alive[f as usize])
+    }
+
+    /// The live triangles in order (what the output mesh gets).
+    pub fn live_triangles(&self) -> Vec<[u32; 3]> {
+        self.alive_faces().map(|f| self.tris[f as usize]).collect()
+    }
+
+    /// Edge length helper.
+    pub fn len(&self, a: u32, b: u32) -> f64 {
+        crate::geometry::norm(sub(self.pos[a as usize], self.pos[b as usize]))
+    }
+}

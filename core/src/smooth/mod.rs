@@ -1,0 +1,199 @@
+//! The smooth job: explicit Laplacian and Taubin, implicit (backward Euler) diffusion, mean-curvature
+//! flow, k-harmonic fairing, seed 004 shape inflation, seed 000 tangential flows.
+//!
+//! Every method works on one [`crate::laplacian::Operator`] (`L = D⁻¹S`, see that module for the
+//! conventions) and one [`constraints::Freedom`] (which vertices move, with which weight). The
+//! implicit methods solve `(D/w + hS) x = (D/w) x₀` over the moving vertices (fixed ones
+//! eliminated), which is symmetric positive definite for every operator: the seed's sign slip in
+//! eq. 3-8/4-2 (`I − λL` with a PSD `L`) is fixed by construction.
+
+pub mod constraints;
+mod methods;
+pub mod params;
+pub mod system;
+
+use serde_json::json;
+
+pub use params::{BoundaryMode, Method, SmoothParams};
+
+use crate::error::{Error, Result};
+use crate::job::{Output, Progress, Stages};
+use crate::laplacian::{self, MassKind, Operator, OperatorKind, Stencil};
+use crate::mesh::{Mesh, Point3};
+use crate::metrics;
+use params::Resolved;
+use system::SolverStats;
+
+/// Everything a method needs, prepared once.
+pub(crate) struct Ctx<'a> {
+    pub mesh: &'a Mesh,
+    pub r: &'a Resolved,
+    pub progress: &'a Progress,
+    pub stencil: Stencil,
+    pub op: Operator,
+    pub boundary: Vec<bool>,
+    pub free: constraints::Freedom,
+    /// Mean edge length of the input (the length unit of relative time steps).
+    pub edge_len: f64,
+    pub center: Point3,
+    pub volume0: f64,
+    pub solver: SolverStats,
+    pub warnings: Vec<String>,
+}
+
+impl Ctx<'_> {
+    /// The time step in the units of the operator (see `SmoothParams::time_step`).
+    pub fn effective_step(&self, h: f64) -> f64 {
+        if self.r.relative_time_step && self.r.operator.area_scaled() {
+            h * self.edge_len * self.edge_len
+        } else {
+            h
+        }
+    }
+
+    /// Applies the axis mask and volume preservation after a step from `before`.
+    pub fn finish_step(&self, x: &mut [Point3], before: &[Point3]) {
+        constraints::apply_axes(x, before, self.r.axes);
+        if self.r.preserve_volume {
+            constraints::preserve_volume(self.mesh, x, &self.free.moving, self.center, self.volume0);
+        }
+    }
+
+    /// Reports progress of step `k` of `n` and checks for cancellation.
+    pub fn tick(&self, k: usize, n: usize) -> Result<()> {
+        self.progress.fraction(k as f64 / n.max(1) as f64)
+    }
+}
+
+/// Runs the smooth job on `mesh`.
+pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Output> {
+    let r = params.resolve()?;
+    let mut stages = Stages::new();
+    if mesh.faces.is_empty() {
+        return Err(Error::InvalidMesh {
+            location: crate::error::Location::Face(0),
+            message: "the mesh has no faces to smooth".into(),
+        });
+    }
+    let n = mesh.vertex_count();
+    let (stencil, op) = stages.run(progress, "assemble", || {
+        let st = Stencil::new(&mesh.faces, n, laplacian::layout_for(r.operator, &mesh.faces))?;
+        let op = laplacian::assemble(&mesh.positions, &mesh.faces, &st, r.operator, r.mass);
+        Ok((st, op))
+    })?;
+    let mut ctx = stages.run(progress, "prepare", || {
+        let boundary = stencil.boundary_vertices();
+        let free = constraints::freedom(&mesh, params, r.boundary, &boundary, &op.locked, r.method == Method::Fair)?;
+        let edge_len = laplacian::mean_edge_length(&stencil, &mesh.positions);
+        let center = centroid(&mesh.positions);
+        let volume0 = metrics::volume_about(&mesh.positions, &mesh.faces, center);
+        Ok(Ctx {
+            mesh: &mesh,
+            r: &r,
+            progress,
+            stencil,
+            op,
+            boundary,
+            free,
+            edge_len,
+            center,
+            volume0,
+            solver: SolverStats { kind: "none".into(), ..Default::default() },
+            warnings: Vec::new(),
+        })
+    })?;
+    let x = stages.run(progress, "smooth", || methods::run(&mut ctx))?;
+    let report = stages.run(progress, "metrics", || Ok(report(&ctx, &x)))?;
+    let mut report = report;
+    let obj = report.as_object_mut().ok_or_else(|| Error::Internal("report".into()))?;
+    obj.insert("total_ms".into(), json!(stages.total_ms()));
+    obj.insert("stages".into(), stages.to_json());
+    let mut out = mesh.clone();
+    if out.normals.is_some() {
+        out.normals = Some(vertex_normals(&x, &out));
+    }
+    out.positions = x;
+    Ok(Output { meshes: vec![out], report, ..Default::default() })
+}
+
+fn centroid(x: &[Point3]) -> Point3 {
+    let mut c = [0.0; 3];
+    for p in x {
+        for k in 0..3 {
+            c[k] += p[k];
+        }
+    }
+    let n = x.len().max(1) as f64;
+    [c[0] / n, c[1] / n, c[2] / n]
+}
+
+/// Area-weighted vertex normals (seed 001 eq. 3), unit length.
+pub fn vertex_normals(x: &[Point3], mesh: &Mesh) -> Vec<Point3> {
+    let mut nr = vec![[0.0; 3]; x.len()];
+    for f in mesh.faces.iter() {
+        let fnorm = metrics::face_normal(x, f);
+        for &v in f {
+            let a = &mut nr[v as usize];
+            for k in 0..3 {
+                a[k] += fnorm[k];
+            }
+        }
+    }
+    nr.into_iter().map(crate::geometry::normalize).collect()
+}
+
+fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
+    let mesh = ctx.mesh;
+    let x0 = &mesh.positions;
+    let f = &mesh.faces;
+    let (max_d, mean_d) = metrics::displacement(x0, x);
+    let a0 = metrics::angle_stats(x0, f);
+    let a1 = metrics::angle_stats(x, f);
+    let vol1 = metrics::volume_about(x, f, ctx.center);
+    let (area0, area1) = (metrics::area(x0, f), metrics::area(x, f));
+    let curvature = |p: &[Point3]| {
+        laplacian::operator(p, f, OperatorKind::Cotan, MassKind::Voronoi)
+            .map(|op| metrics::mean_curvature(&op, p, &ctx.boundary))
+            .unwrap_or(f64::NAN)
+    };
+    let (h0, h1) = rayon::join(|| curvature(x0), || curvature(x));
+    let hausdorff =
+        if ctx.r.hausdorff { Some(crate::spatial::hausdorff_vertices(x0, f, x, f)) } else { None };
+    let diag = crate::geometry::Aabb::of(x0).map(|b| b.diagonal()).unwrap_or(0.0);
+    let moving = ctx.free.moving.iter().filter(|m| **m).count();
+    json!({
+        "method": ctx.r.method,
+        "operator": ctx.r.operator,
+        "params": ctx.r,
+        "vertices": mesh.vertex_count(),
+        "faces": mesh.face_count(),
+        "moving_vertices": moving,
+        "pinned_vertices": ctx.free.pinned_count,
+        "feature_vertices": ctx.free.feature_vertices,
+        "boundary_vertices": ctx.boundary.iter().filter(|b| **b).count(),
+        "locked_vertices": ctx.op.locked.iter().filter(|b| **b).count(),
+        "degenerate_triangles": ctx.op.degenerate_triangles,
+        "nonmanifold_edges": ctx.stencil.nonmanifold_edges(),
+        "mean_edge_length": ctx.edge_len,
+        "time_step_effective": ctx.effective_step(ctx.r.time_step),
+        "volume_before": ctx.volume0,
+        "volume_after": vol1,
+        "volume_change": metrics::relative_change(ctx.volume0, vol1),
+        "area_change": metrics::relative_change(area0, area1),
+        "max_displacement": max_d,
+        "mean_displacement": mean_d,
+        "hausdorff": hausdorff,
+        "hausdorff_relative": hausdorff.map(|h| if diag > 0.0 { h / diag } else { 0.0 }),
+        "min_angle_before": a0.min,
+        "min_angle_after": a1.min,
+        "mean_min_angle_before": a0.mean_min,
+        "mean_min_angle_after": a1.mean_min,
+        "max_angle_before": a0.max,
+        "max_angle_after": a1.max,
+        "flipped_faces": metrics::flipped_faces(x0, x, f),
+        "mean_curvature_before": h0,
+        "mean_curvature_after": h1,
+        "solver": ctx.solver,
+        "warnings": ctx.warnings,
+    })
+}
