@@ -44,6 +44,13 @@ fn meshes() -> Vec<(&'static str, Mesh)> {
         // 70k vertices: indices must switch from u16 to u32.
         ("big-grid", shapes::triangle_grid(300, 240, 0.01)),
     ];
+    // A file another program wrote (Blender), read and written again by us.
+    let blender = repo_root().join("core/tests/gltf_fixtures/blender-scene.glb");
+    let bytes = std::fs::read(&blender).expect("Blender fixture");
+    out.push((
+        "blender-rewritten",
+        meshwork_core::io::gltf::read(&bytes, &Default::default()).expect("read").mesh,
+    ));
     let spot = repo_root().join("../shared/meshes/spot.obj");
     if let Ok(bytes) = std::fs::read(&spot) {
         if let Ok(l) = meshwork_core::io::read(&bytes, &Default::default()) {
