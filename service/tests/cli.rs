@@ -1,0 +1,117 @@
+//! The `meshwork` command line, run as a subprocess on the shared meshes.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use common::{shared_mesh, BIN, TETRA_OBJ};
+use meshwork_core::io::{read, ReadOptions};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("run meshwork")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("meshwork-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// No panic message or backtrace ever reaches the user.
+fn assert_clean(o: &Output) {
+    let e = stderr(o);
+    assert!(!e.contains("panicked") && !e.contains("RUST_BACKTRACE") && !e.contains("stack backtrace"), "{e}");
+}
+
+#[test]
+fn convert_writes_readable_output_and_reports_to_stdout() {
+    let out = tmp("cow.obj");
+    let cow = shared_mesh("cow.obj");
+    let o = run(&["convert", cow.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = read(&std::fs::read(&out).unwrap(), &ReadOptions::default()).unwrap().mesh;
+    // shared/meshes/README.md: cow.obj has 2,903 vertices and 5,804 triangles.
+    assert_eq!((m.vertex_count(), m.face_count()), (2903, 5804));
+    // The report goes to stdout when the mesh goes to a file.
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).expect("report JSON on stdout");
+    assert_eq!(report["vertices"], 2903);
+    assert!(report["total_ms"].is_number() && report["stages"].is_object());
+    assert_eq!(report["inputs"][0]["format"], "obj");
+}
+
+#[test]
+fn report_file_params_file_and_stdout_output() {
+    let rep = tmp("r.json");
+    let params = tmp("p.json");
+    std::fs::write(&params, "{}").unwrap();
+    let input = tmp("t.obj");
+    std::fs::write(&input, TETRA_OBJ).unwrap();
+    let o = run(&["convert", input.to_str().unwrap(), "-o", "-", "--format", "obj", "--report",
+        rep.to_str().unwrap(), "--params", params.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = read(&o.stdout, &ReadOptions { name_hint: Some("obj".into()), ..Default::default() }).unwrap().mesh;
+    assert_eq!((m.vertex_count(), m.face_count()), (4, 4));
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&rep).unwrap()).unwrap();
+    assert_eq!(r["faces"], 4);
+}
+
+#[test]
+fn bad_input_and_params_exit_2_with_kind_and_location() {
+    let input = tmp("bad.obj");
+    std::fs::write(&input, "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = tmp("never.obj");
+    let o = run(&["convert", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("error[malformed-input]") && e.contains("line 2"), "{e}");
+    assert!(!out.exists(), "no output on failure");
+    assert_clean(&o);
+
+    let good = tmp("good.obj");
+    std::fs::write(&good, TETRA_OBJ).unwrap();
+    // Unknown job parameter, from a flag: named.
+    let o = run(&["convert", good.to_str().unwrap(), "-o", out.to_str().unwrap(), "--bogus-thing", "3"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("error[invalid-params]") && stderr(&o).contains("bogus_thing"), "{}", stderr(&o));
+    // Unknown key in a params file.
+    let p = tmp("bad-params.json");
+    std::fs::write(&p, "{\"weird\": 1}").unwrap();
+    let o = run(&["convert", good.to_str().unwrap(), "-o", out.to_str().unwrap(), "--params", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("weird"), "{}", stderr(&o));
+    // Missing file, unknown output extension, missing -o, wrong input count.
+    let o = run(&["convert", "/nonexistent/x.obj", "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("/nonexistent/x.obj"));
+    let o = run(&["convert", good.to_str().unwrap(), "-o", tmp("x.xyz").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&["convert", good.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&["fit", good.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("inputs"), "{}", stderr(&o));
+    assert_clean(&o);
+}
+
+#[test]
+fn piped_run_prints_no_progress_line() {
+    let good = tmp("quiet.obj");
+    std::fs::write(&good, TETRA_OBJ).unwrap();
+    let o = run(&["convert", good.to_str().unwrap(), "-o", tmp("quiet-out.obj").to_str().unwrap()]);
+    assert!(o.status.success());
+    assert_eq!(stderr(&o), "", "stderr is not a terminal: nothing extra");
+}
+
+#[test]
+fn help_lists_every_command() {
+    let o = run(&["--help"]);
+    let t = String::from_utf8_lossy(&o.stdout);
+    for c in ["info", "convert", "repair", "smooth", "fit", "morph", "serve", "openapi"] {
+        assert!(t.contains(c), "{c} missing from --help");
+    }
+}
