@@ -154,6 +154,9 @@ fn beetle_tangle_does_not_panic_and_ends_without_non_manifold_edges() {
     let r = analyze(&out);
     assert_eq!(r.non_manifold_edges, 0, "{rep}");
     assert_eq!(r.non_manifold_vertices, 0, "{rep}");
+    // Split copies sit on the original positions; hole patches must not make zero-area faces
+    // between them.
+    assert_eq!(r.degenerate_faces, 0, "{rep}");
 }
 
 // ---- analytic shapes -------------------------------------------------------------------
