@@ -135,10 +135,15 @@ fn stl_ascii_hand_written() {
     let src = "solid tet\n facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0\n\
                endloop\n endfacet\n facet normal 0 -1 0\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 0 0 1\n\
                endloop\n endfacet\nendsolid tet\n";
-    let l = read(src.as_bytes());
-    assert_eq!(l.format, Format::Stl);
-    assert_eq!(l.mesh.positions, vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
-    assert_eq!(l.mesh.faces, Faces::from_triangles(&[[0, 1, 2], [0, 2, 3]]));
+    for src in [src.to_string(), src.to_uppercase().replace("\n", "\r\n")] {
+        let l = read(src.as_bytes());
+        assert_eq!(l.format, Format::Stl);
+        assert_eq!(
+            l.mesh.positions,
+            vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+        );
+        assert_eq!(l.mesh.faces, Faces::from_triangles(&[[0, 1, 2], [0, 2, 3]]));
+    }
 }
 
 #[test]
@@ -154,4 +159,16 @@ fn detection_by_content_then_name() {
     assert_eq!(detect(b"\x00\x01garbage", Some("mesh.stl")).unwrap(), Format::Stl);
     assert_eq!(detect(b"\x00\x01garbage", None).unwrap_err().kind(), "unsupported-format");
     assert_eq!(detect(b"", None).unwrap_err().kind(), "malformed-input");
+}
+
+#[test]
+fn gltf_json_is_detected_and_read_through_io_read() {
+    // The glTF writer's JSON output must come back through content detection (`{` + "asset").
+    let m = shapes::icosphere(1, 1.0);
+    let b = io::write(&m, Format::Gltf).unwrap();
+    assert_eq!(detect(&b, None).unwrap(), Format::Gltf);
+    let l = read(&b);
+    assert_eq!(l.format, Format::Gltf);
+    assert_eq!(l.mesh.vertex_count(), m.vertex_count());
+    assert_eq!(l.mesh.faces, m.faces);
 }
