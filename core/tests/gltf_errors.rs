@@ -321,3 +321,66 @@ fn truncations_and_bit_flips_never_panic() {
         }
     }
 }
+
+/// Every number in a JSON tree, by pointer.
+fn number_pointers(v: &Value, at: String, out: &mut Vec<String>) {
+    match v {
+        Value::Number(_) => out.push(at),
+        Value::Array(a) => {
+            a.iter().enumerate().for_each(|(i, x)| number_pointers(x, format!("{at}/{i}"), out))
+        }
+        Value::Object(o) => o.iter().for_each(|(k, x)| number_pointers(x, format!("{at}/{k}"), out)),
+        _ => {}
+    }
+}
+
+#[test]
+fn mutated_json_numbers_never_panic() {
+    // Structure-aware fuzzing: the JSON stays valid, its numbers (indices, counts, offsets,
+    // strides, component types, modes) take hostile values.
+    let (bin, mut d) = triangle();
+    d["accessors"][0]["sparse"] = json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5123 }, "values": { "bufferView": 0 } });
+    d["meshes"][0]["primitives"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "attributes": { "POSITION": 0 }, "indices": 1, "mode": 5 }));
+    d["nodes"] = json!([{ "children": [1], "scale": [1, 2, 3] }, { "mesh": 0, "rotation": [0, 0, 0, 1] }]);
+    let mut pointers = Vec::new();
+    number_pointers(&d, String::new(), &mut pointers);
+    let hostile = [
+        json!(0),
+        json!(1),
+        json!(2),
+        json!(3),
+        json!(4),
+        json!(7),
+        json!(255),
+        json!(5121),
+        json!(5126),
+        json!(65535),
+        json!(1u64 << 31),
+        json!((1u64 << 32) + 1),
+        json!(u64::MAX),
+        json!(-1),
+        json!(1e300),
+        json!(0.5),
+    ];
+    let opts = ReadOptions::default();
+    let mut rng = Rng(0xDEAD_BEEF_CAFE_F00D);
+    let mut refused = 0;
+    for _ in 0..4000 {
+        let mut m = d.clone();
+        for _ in 0..1 + rng.next() % 2 {
+            let p = &pointers[(rng.next() % pointers.len() as u64) as usize];
+            *m.pointer_mut(p).unwrap() = hostile[(rng.next() % hostile.len() as u64) as usize].clone();
+        }
+        match read(&glb(&m, &bin.bytes), &opts) {
+            Ok(l) => l.mesh.check().unwrap(),
+            Err(e) => {
+                assert_ne!(e.kind(), "internal", "{e}");
+                refused += 1;
+            }
+        }
+    }
+    assert!(refused > 1000, "most mutations should be refused, only {refused} were");
+}

@@ -152,3 +152,15 @@ fn out_of_f32_range_coordinates_are_refused_by_the_writer() {
     assert_eq!(err.kind(), "invalid-mesh", "{err}");
     assert!(err.to_string().contains("vertex 1"), "{err}");
 }
+
+#[test]
+fn generic_io_detects_both_encodings() {
+    use meshwork_core::io;
+    let mesh = shapes::icosphere(1, 1.0);
+    for format in [Format::Glb, Format::Gltf] {
+        let bytes = io::write(&mesh, format).unwrap();
+        let loaded = io::read(&bytes, &ReadOptions::default()).unwrap();
+        assert_eq!(loaded.format, format);
+        assert_eq!(loaded.mesh.faces, mesh.faces);
+    }
+}

@@ -3,8 +3,10 @@
 //!
 //! Detection uses both the seed's flip counter (each vertex's projected motion against the line
 //! of its opposite edge; odd count = flipped) and a direct orientation test of the moved triangle
-//! projected on the original plane. The counter is exact only when one vertex moves (the seed
-//! note), so a face is flagged when either test says so.
+//! projected on the original plane; a face is flagged when either test says so. The counter is
+//! exact only when one vertex moves (seed note): with the absolute motion the seed uses, a plain
+//! translation larger than the triangle counts as a crossing and flagged a fifth of a real fit, so
+//! each vertex's motion is taken relative to its opposite edge's midpoint.
 
 use std::collections::HashMap;
 
@@ -34,7 +36,10 @@ pub fn detect(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> FlipSca
         let mut counter = 0;
         for i in 0..3 {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            let t_i = sub(proj[i], p[i]);
+            // The vertex's motion relative to its opposite edge (the seed uses the absolute motion,
+            // which counts a plain translation larger than the triangle as a crossing).
+            let edge_motion = scale(crate::geometry::add(sub(proj[j], p[j]), sub(proj[k], p[k])), 0.5);
+            let t_i = sub(sub(proj[i], p[i]), edge_motion);
             let d_i = sub(p[k], p[j]);
             // p_i + r t_i = p_j + s d_i, solved in the plane via cross products with n.
             let den = dot(cross(t_i, d_i), n);

@@ -483,6 +483,8 @@ fn fine_fit(
         .collect();
     let mut flagged_per_round = Vec::new();
     let mut faces_added = 0;
+    let budget = tris.len(); // subdivision may at most double the face count
+    let mut best: Option<(Fine, Vec<Point3>, Vec<[u32; 3]>)> = None;
     for round in 0..=params.max_flip_iterations {
         progress.check()?;
         let corr = correspond::closest(pos, net, &pair_fixed, progress)?;
@@ -513,26 +515,44 @@ fn fine_fit(
         }
         let scan = flips::detect(pos, &moved, tris);
         flagged_per_round.push(scan.flipped.len());
-        if scan.flipped.is_empty() || round == params.max_flip_iterations {
-            let n = corr.distances.len().max(1) as f64;
-            return Ok(Fine {
-                positions: moved,
-                vertex_of_point: vop,
-                report: FineReport {
-                    rounds: round + 1,
-                    correspondence_conflicts: corr.conflicts,
-                    correspondence_distance_max: corr.distances.iter().cloned().fold(0.0, f64::max),
-                    correspondence_distance_mean: corr.distances.iter().sum::<f64>() / n,
-                    flagged_per_round,
-                    flagged_by_counter: scan.by_counter,
-                    flagged_by_orientation: scan.by_orientation,
-                    faces_added,
-                    flipped_faces: scan.flipped.len(),
-                    augmented,
-                },
-            });
+        let n = corr.distances.len().max(1) as f64;
+        let flagged = scan.flipped.clone();
+        let fine = Fine {
+            positions: moved,
+            vertex_of_point: vop,
+            report: FineReport {
+                rounds: round + 1,
+                correspondence_conflicts: corr.conflicts,
+                correspondence_distance_max: corr.distances.iter().cloned().fold(0.0, f64::max),
+                correspondence_distance_mean: corr.distances.iter().sum::<f64>() / n,
+                flagged_per_round: Vec::new(),
+                flagged_by_counter: scan.by_counter,
+                flagged_by_orientation: scan.by_orientation,
+                faces_added,
+                flipped_faces: scan.flipped.len(),
+                augmented,
+            },
+        };
+        // Keep the round with the fewest flips; subdivision that does not reduce them stops the
+        // loop (it would only grow the mesh where the field itself is too steep).
+        let improves = best.as_ref().is_none_or(|b| fine.report.flipped_faces < b.0.report.flipped_faces);
+        if improves {
+            best = Some((fine, pos.clone(), tris.clone()));
         }
-        faces_added += flips::subdivide(pos, tris, &scan.flipped);
+        let done = flagged.is_empty()
+            || !improves
+            || round == params.max_flip_iterations
+            || faces_added + 3 * flagged.len() * 2 > budget;
+        if done {
+            break;
+        }
+        faces_added += flips::subdivide(pos, tris, &flagged);
+    }
+    if let Some((mut fine, p, t)) = best {
+        *pos = p;
+        *tris = t;
+        fine.report.flagged_per_round = flagged_per_round;
+        return Ok(fine);
     }
     Err(Error::Internal("flip loop ended without a result".into()))
 }

@@ -44,6 +44,12 @@ pub struct RetriStats {
     pub fallback_moved_vertices: usize,
     /// Segments that could not be realised at all.
     pub failed_segments: usize,
+    /// Why walks stopped (one count per failed walk piece).
+    pub walk_fail_start: usize,
+    pub walk_fail_boundary: usize,
+    pub walk_fail_curve_edge: usize,
+    pub walk_fail_lost: usize,
+    pub walk_fail_fill: usize,
 }
 
 pub struct Realised {
@@ -81,7 +87,15 @@ enum Walk {
     SnapAtStart(u32),
     /// Faces crossed and the (left, right) edges between them, ending at `end` (w, or a vertex to snap).
     Strip { faces: Vec<u32>, crossed: Vec<(u32, u32)>, end: u32 },
-    Fail,
+    Fail(FailReason),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum FailReason {
+    Start,
+    Boundary,
+    CurveEdge,
+    Lost,
 }
 
 pub fn realise(
@@ -155,12 +169,14 @@ fn walk_segment(
     let d = sub(b, a);
     let len = norm(d);
     if len == 0.0 {
+        stats.walk_fail_start += 1;
         return false;
     }
     let dir = scale(d, 1.0 / len);
     let n = add(mesh.vertex_normal(u), mesh.vertex_normal(w));
     let n = normalize(sub(n, scale(dir, dot(n, dir))));
     if n == [0.0; 3] {
+        stats.walk_fail_start += 1;
         return false;
     }
     let cut = Cut { a, dir, side: cross(n, dir), len };
@@ -185,6 +201,7 @@ fn walk_segment(
                 }
                 if !retriangulate(mesh, cur, end, &faces, &crossed) {
                     mesh.pos[end as usize] = old;
+                    stats.walk_fail_fill += 1;
                     return false;
                 }
                 chain.push(end);
@@ -195,7 +212,15 @@ fn walk_segment(
                 stats.snapped_vertices += 1;
                 cur = end;
             }
-            Walk::Fail => return false,
+            Walk::Fail(r) => {
+                match r {
+                    FailReason::Start => stats.walk_fail_start += 1,
+                    FailReason::Boundary => stats.walk_fail_boundary += 1,
+                    FailReason::CurveEdge => stats.walk_fail_curve_edge += 1,
+                    FailReason::Lost => stats.walk_fail_lost += 1,
+                }
+                return false;
+            }
         }
     }
     false
@@ -248,11 +273,13 @@ fn walk(
         let (l, r) = if sx >= 0.0 { (x, y) } else { (y, x) };
         let c = crossing(mesh, cut, l, r).0;
         let fwd = dot(normalize(sub(c, pf)), cut.dir);
-        if fwd > 0.0 && best.is_none_or(|b| fwd > b.3) {
+        // The most forward of the (usually two) crossings; it may point slightly backwards when the
+        // chord leaves the surface steeply, the later checks catch a wrong start.
+        if best.is_none_or(|b| fwd > b.3) {
             best = Some((f, l, r, fwd));
         }
     }
-    let Some((f0, mut l, mut r, _)) = best else { return Walk::Fail };
+    let Some((f0, mut l, mut r, _)) = best else { return Walk::Fail(FailReason::Start) };
     let (_, lam) = crossing(mesh, cut, l, r);
     for (v, near) in [(l, lam < snap), (r, 1.0 - lam < snap)] {
         if near && cut.t(mesh.pos[v as usize]) < t_end && snappable(mesh, cut, v, on_curve) {
@@ -261,7 +288,7 @@ fn walk(
     }
     let locked = |a: u32, b: u32| locked_edges.contains(&(a.min(b), a.max(b)));
     if locked(l, r) {
-        return Walk::Fail;
+        return Walk::Fail(FailReason::CurveEdge);
     }
     let mut faces = vec![f0];
     let mut crossed = vec![(l, r)];
@@ -269,12 +296,12 @@ fn walk(
     seen.insert(f0);
     let mut cur = f0;
     for _step in 0..mesh.tris.len().min(1_000_000) {
-        let Some(g) = mesh.across(cur, l, r) else { return Walk::Fail };
+        let Some(g) = mesh.across(cur, l, r) else { return Walk::Fail(FailReason::Boundary) };
         if !seen.insert(g) {
-            return Walk::Fail;
+            return Walk::Fail(FailReason::Lost);
         }
         let t = mesh.tris[g as usize];
-        let Some(&z) = t.iter().find(|&&v| v != l && v != r) else { return Walk::Fail };
+        let Some(&z) = t.iter().find(|&&v| v != l && v != r) else { return Walk::Fail(FailReason::Lost) };
         faces.push(g);
         if z == to {
             return Walk::Strip { faces, crossed, end: to };
@@ -283,19 +310,19 @@ fn walk(
         let (nl, nr) = if z_left { (z, r) } else { (l, z) };
         let (c, lam) = crossing(mesh, cut, nl, nr);
         if cut.t(c) > t_end + 0.25 * cut.len {
-            return Walk::Fail; // passed the end without meeting it
+            return Walk::Fail(FailReason::Lost); // passed the end without meeting it
         }
         let near_z = if z_left { lam < snap } else { 1.0 - lam < snap };
         if near_z && cut.t(mesh.pos[z as usize]) < t_end && snappable(mesh, cut, z, on_curve) {
             return Walk::Strip { faces, crossed, end: z };
         }
         if locked(nl, nr) {
-            return Walk::Fail;
+            return Walk::Fail(FailReason::CurveEdge);
         }
         crossed.push((nl, nr));
         (l, r, cur) = (nl, nr, g);
     }
-    Walk::Fail
+    Walk::Fail(FailReason::Lost)
 }
 
 /// Where the cut plane crosses edge (l, r) (s(l) ≥ 0 > s(r)): the point and its parameter from l.
@@ -446,6 +473,8 @@ fn dijkstra_project(mesh: &mut TriMesh, from: u32, to: u32, on_curve: &[bool]) -
     let mut heap = BinaryHeap::new();
     dist.insert(from, 0.0);
     heap.push(Reverse((0u64, from)));
+    // A path much longer than the segment would drag far-away vertices onto it: give up instead.
+    let reach = 4.0 * mesh.len(from, to);
     let mut pops = 0usize;
     while let Some(Reverse((dbits, v))) = heap.pop() {
         let dv = f64::from_bits(dbits);
@@ -456,7 +485,7 @@ fn dijkstra_project(mesh: &mut TriMesh, from: u32, to: u32, on_curve: &[bool]) -
             break;
         }
         pops += 1;
-        if pops > 2_000_000 {
+        if pops > 200_000 || dv > reach {
             return None;
         }
         for &f in mesh.faces_of(v) {

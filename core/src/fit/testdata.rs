@@ -126,3 +126,52 @@ pub fn bend(p: Point3, size: f64) -> Point3 {
     let (x, y, z) = (p[0] / size, p[1] / size, p[2] / size);
     [size * (1.1 * x + 0.08 * y * y), size * (0.95 * y + 0.05 * (2.0 * x).sin()), size * (1.05 * z + 0.06 * x * x)]
 }
+
+/// Keeps every `k`-th vertex along the runs between network nodes (vertices whose degree is not
+/// 2, kept always), returning polylines node to node. Used to make a section network coarser than
+/// the template it is fitted with.
+pub fn thin_network(curves: &Mesh, k: usize) -> Mesh {
+    let k = k.max(1);
+    let mut adj: HashMap<u32, Vec<u32>> = HashMap::new();
+    for c in &curves.curves {
+        for w in c.windows(2) {
+            if w[0] != w[1] {
+                adj.entry(w[0]).or_default().push(w[1]);
+                adj.entry(w[1]).or_default().push(w[0]);
+            }
+        }
+    }
+    let is_node = |v: u32| adj.get(&v).map_or(true, |n| n.len() != 2);
+    let mut used: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    let mut lines: Vec<Vec<u32>> = Vec::new();
+    let mut starts: Vec<u32> = adj.keys().copied().filter(|&v| is_node(v)).collect();
+    starts.sort();
+    // Closed loops without any node: start anywhere on them afterwards.
+    let mut rest: Vec<u32> = adj.keys().copied().filter(|&v| !is_node(v)).collect();
+    rest.sort();
+    for s in starts.into_iter().chain(rest) {
+        for &first in adj[&s].clone().iter() {
+            if used.contains(&(s.min(first), s.max(first))) {
+                continue;
+            }
+            let mut run = vec![s];
+            let (mut prev, mut cur) = (s, first);
+            used.insert((s.min(first), s.max(first)));
+            loop {
+                run.push(cur);
+                if is_node(cur) || cur == s {
+                    break;
+                }
+                let Some(&next) = adj[&cur].iter().find(|&&n| n != prev && !used.contains(&(cur.min(n), cur.max(n)))) else {
+                    break;
+                };
+                used.insert((cur.min(next), cur.max(next)));
+                (prev, cur) = (cur, next);
+            }
+            let last = run.len() - 1;
+            let kept: Vec<u32> = run.iter().enumerate().filter(|(i, _)| i % k == 0 || *i == last).map(|(_, &v)| v).collect();
+            lines.push(kept);
+        }
+    }
+    Mesh { positions: curves.positions.clone(), curves: lines, ..Default::default() }
+}

@@ -333,11 +333,13 @@ impl<'a> Store<'a> {
                 let elem = h.component.size() * h.width;
                 out = Vec::with_capacity(total);
                 let cs = h.component.size();
-                for e in 0..h.count {
-                    let start = offset + e * stride;
-                    let el = &bytes[start..start + elem];
-                    for c in 0..h.width {
-                        out.push(read(&el[c * cs..(c + 1) * cs]));
+                if stride == elem {
+                    // Tightly packed (the common case): one pass over the components.
+                    out.extend(bytes[offset..offset + h.count * elem].chunks_exact(cs).map(&read));
+                } else {
+                    for e in 0..h.count {
+                        let start = offset + e * stride;
+                        out.extend(bytes[start..start + elem].chunks_exact(cs).map(&read));
                     }
                 }
             }

@@ -18,16 +18,16 @@ pub fn encode(bytes: &[u8]) -> String {
     out
 }
 
-fn value(c: u8) -> Option<u32> {
-    Some(match c {
-        b'A'..=b'Z' => c - b'A',
-        b'a'..=b'z' => c - b'a' + 26,
-        b'0'..=b'9' => c - b'0' + 52,
-        b'+' => 62,
-        b'/' => 63,
-        _ => return None,
-    } as u32)
-}
+/// Sextet value of each byte, 255 for bytes outside the alphabet.
+const VALUES: [u8; 256] = {
+    let mut t = [255u8; 256];
+    let mut i = 0;
+    while i < 64 {
+        t[ALPHABET[i] as usize] = i as u8;
+        i += 1;
+    }
+    t
+};
 
 /// Decodes base64 text; padding is optional. On failure returns the byte offset of the first bad
 /// character (or the text length for a truncated final group).
@@ -44,7 +44,11 @@ pub fn decode(text: &[u8]) -> Result<Vec<u8>, usize> {
     for (ci, chunk) in body.chunks(4).enumerate() {
         let mut n = 0u32;
         for (i, &c) in chunk.iter().enumerate() {
-            n |= value(c).ok_or(ci * 4 + i)? << (18 - 6 * i);
+            let v = VALUES[c as usize];
+            if v == 255 {
+                return Err(ci * 4 + i);
+            }
+            n |= u32::from(v) << (18 - 6 * i);
         }
         let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
         out.extend_from_slice(&bytes[..chunk.len() - 1]);

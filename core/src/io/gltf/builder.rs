@@ -69,8 +69,12 @@ fn pad_to_4(bytes: &mut Vec<u8>, fill: u8) {
     }
 }
 
-fn f32_bytes(values: &[f32]) -> Vec<u8> {
-    values.iter().flat_map(|v| v.to_le_bytes()).collect()
+/// Appends little-endian bytes straight into `out` (no intermediate copy: outputs can be 100 MB).
+fn extend_f32(out: &mut Vec<u8>, values: &[f32]) {
+    out.reserve(values.len() * 4);
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
 }
 
 fn check_finite(values: &[f32], width: usize) -> Result<()> {
@@ -103,12 +107,18 @@ impl GltfBuilder {
 
     /// Appends `bytes` as a new buffer view (starting on a 4-byte boundary); returns its index.
     pub fn buffer_view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        self.buffer_view_with(target, |bin| bin.extend_from_slice(bytes))
+    }
+
+    /// A new buffer view whose bytes `fill` appends to the binary buffer directly.
+    pub fn buffer_view_with(&mut self, target: Option<u32>, fill: impl FnOnce(&mut Vec<u8>)) -> usize {
         pad_to_4(&mut self.bin, 0);
-        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+        let start = self.bin.len();
+        fill(&mut self.bin);
+        let mut view = json!({ "buffer": 0, "byteOffset": start, "byteLength": self.bin.len() - start });
         if let Some(t) = target {
             view["target"] = json!(t);
         }
-        self.bin.extend_from_slice(bytes);
         self.buffer_views.push(view);
         self.buffer_views.len() - 1
     }
@@ -141,7 +151,7 @@ impl GltfBuilder {
             )));
         }
         check_finite(values, width)?;
-        let view = self.buffer_view(&f32_bytes(values), target);
+        let view = self.buffer_view_with(target, |bin| extend_f32(bin, values));
         let mut acc = json!({
             "bufferView": view,
             "componentType": FLOAT,
@@ -159,20 +169,17 @@ impl GltfBuilder {
 
     /// VEC3 float vertex attribute with `min`/`max` (positions, morph target deltas).
     pub fn accessor_vec3(&mut self, values: &[[f32; 3]]) -> Result<usize> {
-        let flat: Vec<f32> = values.iter().flatten().copied().collect();
-        self.accessor_f32(&flat, "VEC3", true, Some(ARRAY_BUFFER))
+        self.accessor_f32(values.as_flattened(), "VEC3", true, Some(ARRAY_BUFFER))
     }
 
     /// VEC3 float vertex attribute without bounds (normals).
     pub fn accessor_vec3_unbounded(&mut self, values: &[[f32; 3]]) -> Result<usize> {
-        let flat: Vec<f32> = values.iter().flatten().copied().collect();
-        self.accessor_f32(&flat, "VEC3", false, Some(ARRAY_BUFFER))
+        self.accessor_f32(values.as_flattened(), "VEC3", false, Some(ARRAY_BUFFER))
     }
 
     /// VEC2 float vertex attribute (texture coordinates).
     pub fn accessor_vec2(&mut self, values: &[[f32; 2]]) -> Result<usize> {
-        let flat: Vec<f32> = values.iter().flatten().copied().collect();
-        self.accessor_f32(&flat, "VEC2", false, Some(ARRAY_BUFFER))
+        self.accessor_f32(values.as_flattened(), "VEC2", false, Some(ARRAY_BUFFER))
     }
 
     /// SCALAR float data with `min`/`max` and no target (animation sampler input/output).
@@ -190,12 +197,18 @@ impl GltfBuilder {
         if max == u32::MAX {
             return Err(Error::Internal("index 4294967295 is reserved in glTF".into()));
         }
-        let (bytes, ctype) = if max < u32::from(u16::MAX) {
-            (indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect::<Vec<u8>>(), UNSIGNED_SHORT)
-        } else {
-            (indices.iter().flat_map(|&i| i.to_le_bytes()).collect(), UNSIGNED_INT)
-        };
-        let view = self.buffer_view(&bytes, Some(ELEMENT_ARRAY_BUFFER));
+        let small = max < u32::from(u16::MAX);
+        let view = self.buffer_view_with(Some(ELEMENT_ARRAY_BUFFER), |bin| {
+            bin.reserve(indices.len() * if small { 2 } else { 4 });
+            for &i in indices {
+                if small {
+                    bin.extend_from_slice(&(i as u16).to_le_bytes());
+                } else {
+                    bin.extend_from_slice(&i.to_le_bytes());
+                }
+            }
+        });
+        let ctype = if small { UNSIGNED_SHORT } else { UNSIGNED_INT };
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": ctype,

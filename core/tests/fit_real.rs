@@ -1,0 +1,185 @@
+//! A real template (homer.obj, closed genus 0) fitted to curves cut from a known deformation of
+//! itself: plane sections of the original surface, moved by `testdata::bend`. Truth: the bent
+//! surface (distance of the fit to it), and the number of regions the planes cut the surface into
+//! (counted independently on a finer copy of the original).
+
+use std::collections::HashMap;
+
+use meshwork_core::fit::kdtree::KdTree;
+use meshwork_core::fit::smooth::closest_on_triangle;
+use meshwork_core::fit::testdata::{bend, plane_sections, thin_network};
+use meshwork_core::fit::{run, FitPair, FitParams};
+use meshwork_core::geometry::{dist, dot, triangle_cross, Aabb};
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
+use meshwork_core::Progress;
+
+fn homer() -> Mesh {
+    let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/homer.obj"))
+        .or_else(|_| std::fs::read("../../shared/meshes/homer.obj"))
+        .expect("homer.obj in ../shared/meshes");
+    read(&bytes, &ReadOptions::default()).expect("read homer").mesh
+}
+
+/// Horizontal slices and two vertical ones (offsets chosen off the vertex coordinates).
+fn planes() -> Vec<(Point3, f64)> {
+    let mut p: Vec<(Point3, f64)> = [0.3013, 0.4517, 0.6021, 0.7519, 0.9011].iter().map(|&y| ([0.0, 1.0, 0.0], y)).collect();
+    p.push(([1.0, 0.0, 0.0], 0.4987));
+    p.push(([0.0, 0.0, 1.0], 0.4919));
+    p
+}
+
+/// Regions of the surface minus the planes: faces of a 4×-subdivided copy grouped by the side of
+/// every plane, connected through shared edges; faces cut by a plane are left out.
+fn expected_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
+    let fine = subdivide_midpoint(m, 2);
+    let tris = fan_triangles(&fine.faces);
+    let side = |p: Point3| -> Option<u32> {
+        let mut code = 0;
+        for (k, (n, o)) in planes.iter().enumerate() {
+            let s = dot(*n, p) - o;
+            code |= ((s > 0.0) as u32) << k;
+        }
+        Some(code)
+    };
+    let code: Vec<Option<u32>> = tris
+        .iter()
+        .map(|t| {
+            let c: Vec<Option<u32>> = t.iter().map(|&v| side(fine.positions[v as usize])).collect();
+            if c[0] == c[1] && c[1] == c[2] { c[0] } else { None }
+        })
+        .collect();
+    let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let mut seen = vec![false; tris.len()];
+    let mut count = 0;
+    for s in 0..tris.len() {
+        if seen[s] || code[s].is_none() {
+            continue;
+        }
+        count += 1;
+        let mut stack = vec![s];
+        seen[s] = true;
+        while let Some(f) = stack.pop() {
+            let t = tris[f];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for &g in &edge[&(a.min(b), a.max(b))] {
+                    if !seen[g] && code[g] == code[f] {
+                        seen[g] = true;
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn homer_fits_sections_of_its_bent_self() {
+    let original = homer();
+    let planes = planes();
+    // The template is twice as fine as the curves: sections of the original homer, every second
+    // section point kept; the template is homer split once (same surface, 4× the faces).
+    let mut curves = thin_network(&plane_sections(&original, &planes), 2);
+    let template = subdivide_midpoint(&original, 1);
+    // The user's pairs, as a user would pick them: where sections cross (degree-4 curve points),
+    // the template vertex nearest to the crossing ↔ the crossing on the bent target.
+    let mut degree: HashMap<u32, usize> = HashMap::new();
+    for c in &curves.curves {
+        for &v in c {
+            *degree.entry(v).or_default() += 1;
+        }
+    }
+    let mut crossings: Vec<u32> = degree.iter().filter(|(_, &d)| d >= 4).map(|(&v, _)| v).collect();
+    crossings.sort();
+    let step = (crossings.len() / 12).max(1);
+    let pairs: Vec<FitPair> = crossings
+        .iter()
+        .step_by(step)
+        .map(|&c| {
+            let p = curves.positions[c as usize];
+            let v = (0..template.positions.len())
+                .min_by(|&a, &b| dist(template.positions[a], p).total_cmp(&dist(template.positions[b], p)))
+                .unwrap();
+            FitPair { template_vertex: v as u32, curve_point: bend(p, 1.0) }
+        })
+        .collect();
+    for p in curves.positions.iter_mut() {
+        *p = bend(*p, 1.0);
+    }
+    let truth_pos: Vec<Point3> = template.positions.iter().map(|&p| bend(p, 1.0)).collect();
+    let truth_tris = fan_triangles(&template.faces);
+    let expected = expected_regions(&original, &planes);
+
+    let params = FitParams { pairs, ..Default::default() };
+    let out = run(vec![template.clone(), curves], &params, &Progress::new()).expect("fit");
+    let r = &out.report;
+    eprintln!("{}", serde_json::to_string_pretty(r).unwrap());
+    let m = &out.meshes[0];
+
+    // Distance of every output vertex to the bent surface: closest point over the one-rings of
+    // the 8 nearest truth vertices (an upper bound of the true distance).
+    let tree = KdTree::new(&truth_pos);
+    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); truth_pos.len()];
+    for (f, t) in truth_tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(f as u32);
+        }
+    }
+    let diag = Aabb::of(&truth_pos).unwrap().diagonal();
+    let mut devs: Vec<f64> = m
+        .positions
+        .iter()
+        .map(|&p| {
+            let (v, _) = tree.nearest(p).unwrap();
+            vf[v as usize]
+                .iter()
+                .map(|&f| dist(p, closest_on_triangle(p, truth_tris[f as usize], &truth_pos)))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    devs.sort_by(f64::total_cmp);
+    let mean = devs.iter().sum::<f64>() / devs.len() as f64;
+    let p99 = devs[devs.len() * 99 / 100];
+    let max = *devs.last().unwrap();
+    eprintln!("expected regions {expected}; deviation / diag: mean {:.2e} p99 {:.2e} max {:.2e}", mean / diag, p99 / diag, max / diag);
+
+    // Faces flipped against the truth: output normal vs the truth normal nearest to it.
+    let flipped = m
+        .faces
+        .iter()
+        .filter(|f| {
+            let (a, b, c) = (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
+            let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
+            let (v, _) = tree.nearest(centroid).unwrap();
+            let tn = vf[v as usize].iter().fold([0.0; 3], |acc, &g| {
+                let t = truth_tris[g as usize];
+                let n = triangle_cross(truth_pos[t[0] as usize], truth_pos[t[1] as usize], truth_pos[t[2] as usize]);
+                [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
+            });
+            dot(triangle_cross(a, b, c), tn) < 0.0
+        })
+        .count();
+    eprintln!("faces opposing the truth normal: {flipped}");
+
+    // Every matched curve vertex is exactly on the output.
+    assert!(r["curve_residual_max"].as_f64().unwrap() <= 1e-9 * diag);
+    // The surface between the curves is close to the bent truth (the fit only sees the curves).
+    assert!(mean < 0.004 * diag, "mean deviation {}", mean / diag);
+    assert!(p99 < 0.02 * diag, "p99 deviation {}", p99 / diag);
+    // Known gap (see the fit report in docs): a few segments near crossings fail both the walk
+    // and the fallback, merging regions. Measured here: ≥ 99% of segments as edges, ≤ 0.2% of
+    // faces opposing the truth normal, and at least 80% of the expected regions.
+    assert!(r["segments_as_edges"].as_f64().unwrap() >= 0.99);
+    assert!((flipped as f64) < 0.002 * m.face_count() as f64, "{flipped} faces oppose the truth");
+    let regions = r["regions"].as_u64().unwrap() as usize;
+    assert!(regions <= expected && regions * 10 >= expected * 8, "{regions} regions, {expected} expected");
+}
