@@ -53,9 +53,12 @@ pub struct Report {
     pub components: usize,
     pub components_by_vertex: usize,
     pub boundary_edges: usize,
+    /// Closed boundary loops (holes and rims), each a simple cycle.
     pub boundary_loops: usize,
     /// Edge counts of the boundary loops, longest first.
     pub boundary_loop_lengths: Vec<usize>,
+    /// Boundary walks that could not be closed (they end at non-manifold edges).
+    pub boundary_chains: usize,
     pub non_manifold_edges: usize,
     pub non_manifold_vertices: usize,
     pub pinch_vertices: usize,
@@ -185,8 +188,10 @@ pub fn analyze_staged(
         ))
     })?;
 
-    let mut loop_lengths = stages.run(progress, "boundary_loops", || {
-        Ok(topo.boundary_loops().iter().map(|l| l.edges.len()).collect::<Vec<_>>())
+    let (mut loop_lengths, chains) = stages.run(progress, "boundary_loops", || {
+        let loops = topo.boundary_loops();
+        let chains = loops.iter().filter(|l| !l.closed).count();
+        Ok((loops.iter().filter(|l| l.closed).map(|l| l.edges.len()).collect::<Vec<_>>(), chains))
     })?;
     loop_lengths.sort_unstable_by(|a, b| b.cmp(a));
 
@@ -210,6 +215,7 @@ pub fn analyze_staged(
         boundary_edges,
         boundary_loops: loop_lengths.len(),
         boundary_loop_lengths: loop_lengths,
+        boundary_chains: chains,
         non_manifold_edges: nm_edges.len(),
         non_manifold_vertices: nm_vertices,
         pinch_vertices: pinches,

@@ -224,6 +224,14 @@ pub fn run(mut mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result
             holes::fill(&mut mesh, &holes::FillOptions::from(params), progress)
         })?;
         steps.insert("fill_holes".into(), to_json(&r));
+        // A filled hole that touched a skipped one at a vertex leaves a closed fan next to an open
+        // one there (a non-manifold vertex the fill created): resolve those the same way.
+        if r.filled > 0 && params.non_manifold != NonManifoldMode::Keep {
+            let n = stages.run(progress, "non_manifold_after_fill", || {
+                nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
+            })?;
+            steps.insert("non_manifold_after_fill".into(), to_json(&n));
+        }
         holes_report = Some(r);
     }
     if params.orient && params.outward {
@@ -286,7 +294,7 @@ fn why_not(out: &validate::Report, holes: Option<&holes::FillReport>, params: &R
     if out.pinch_vertices > 0 {
         why.push(format!("{} vertices where boundary loops touch (pinches)", out.pinch_vertices));
     }
-    if out.boundary_loops > 0 {
+    if out.boundary_edges > 0 {
         match holes {
             None => why.push(format!("{} holes left open (fill_holes = false)", out.boundary_loops)),
             Some(h) => {
@@ -294,7 +302,7 @@ fn why_not(out: &validate::Report, holes: Option<&holes::FillReport>, params: &R
                     why.push(format!("{n} holes skipped: {reason}"));
                 }
                 if h.skipped_by_reason.is_empty() {
-                    why.push(format!("{} boundary loops remain", out.boundary_loops));
+                    why.push(format!("{} boundary edges remain", out.boundary_edges));
                 }
             }
         }

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::geometry::signed_volume;
+use crate::geometry::{cross, dot};
 use crate::mesh::{Faces, Mesh};
 use crate::topology::{Connectivity, Topology};
 
@@ -59,10 +59,17 @@ pub fn make_consistent(mesh: &mut Mesh) -> OrientReport {
         }
     }
     let faces_flipped = flip.iter().filter(|&&b| b).count();
+    // Edges still traversed the same way by both faces after the flips (no rebuild needed).
+    let conflicting_edges = (0..topo.edge_count() as u32)
+        .filter(|&e| {
+            let u = topo.edge_uses(e);
+            u.len() == 2
+                && (u[0].forward ^ flip[u[0].face as usize]) == (u[1].forward ^ flip[u[1].face as usize])
+        })
+        .count();
     if faces_flipped > 0 {
         flip_faces(&mut mesh.faces, &flip);
     }
-    let conflicting_edges = Topology::new(mesh).inconsistent_edges().len();
     OrientReport { faces_flipped, conflicting_edges }
 }
 
@@ -75,6 +82,16 @@ pub fn flip_faces(faces: &mut Faces, flip: &[bool]) {
             idx[offsets[f] as usize + 1..offsets[f + 1] as usize].reverse();
         }
     }
+}
+
+/// A face's contribution to the signed volume (fan triangles against the origin, / 6).
+fn face_volume(p: &[crate::mesh::Point3], f: &[u32]) -> f64 {
+    let a = p[f[0] as usize];
+    let mut v = 0.0;
+    for k in 1..f.len().saturating_sub(1) {
+        v += dot(a, cross(p[f[k] as usize], p[f[k + 1] as usize]));
+    }
+    v / 6.0
 }
 
 #[derive(Debug, Clone, Serialize, Default)]
@@ -102,9 +119,7 @@ pub fn outward(mesh: &mut Mesh) -> OutwardReport {
     // Signed volume per component.
     let mut vol = vec![0.0; nc];
     for f in 0..topo.face_count() {
-        let mut one = Faces::new();
-        one.push(topo.face_vertices(f as u32), 0);
-        vol[comps.face_label[f] as usize] += signed_volume(&mesh.positions, &one);
+        vol[comps.face_label[f] as usize] += face_volume(&mesh.positions, topo.face_vertices(f as u32));
     }
     let flip: Vec<bool> = (0..topo.face_count())
         .map(|f| {
