@@ -1,0 +1,505 @@
+//! Spherical parameterisation of a closed genus-0 mesh (seed 002 §4.2), in three steps:
+//!
+//! 1. simplify with recorded half-edge collapses to a working size ([`super::simplify`]);
+//! 2. embed the working mesh by curvature-driven flattening (eq. IV.61–IV.62: the vertex of largest
+//!    |K_s| moves to its neighbours' barycentre, It = 5·V moves a round) until it is star-shaped
+//!    about its centre (every face seen from the centre with positive orientation — the
+//!    visibility check), then project radially (eq. IV.63). If flattening does not reach a
+//!    star shape within `max_flatten_rounds`, simplify further down to a tetrahedron, which embeds
+//!    trivially (Praun–Hoppe), and say so in the report;
+//! 3. undo the collapses one by one (vertex splits), placing each returning vertex at the valid
+//!    candidate of a lattice over its old 1-ring that maximises the worst triangle shape
+//!    (seed 002 Fig. IV.29), so the map stays an embedding by construction.
+//!
+//! Between levels, and at the end, a relaxation pass moves each vertex towards the normalised
+//! mean-value-weighted average of its neighbours (weights from the 3D mesh, which lowers angle
+//! distortion), accepting only moves that flip no triangle.
+//!
+//! Orientation of a spherical triangle (a, b, c): sign of det(a, b, c) (seed 003 eq. 3.5); all
+//! faces of an outward-oriented input must come out positive.
+
+use std::collections::BinaryHeap;
+use std::f64::consts::PI;
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, corner_angle, cross, dot, norm, normalize, scale, sub, triangle_area};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+use super::simplify::Hierarchy;
+use super::trimesh::TriMesh;
+
+/// f64 ordered for a max-heap.
+#[derive(PartialEq)]
+struct Key(f64);
+impl PartialOrd for Key {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Eq for Key {}
+impl Ord for Key {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+/// det(a, b, c): positive for a counter-clockwise (outward) spherical triangle.
+#[inline]
+pub fn orient(a: Point3, b: Point3, c: Point3) -> f64 {
+    dot(cross(a, b), c)
+}
+
+/// Settings of the parameterisation (a subset of the job parameters).
+#[derive(Clone, Debug)]
+pub struct ParamSettings {
+    pub working_vertices: usize,
+    pub max_flatten_rounds: usize,
+    pub relax_sweeps: usize,
+    pub final_relax_sweeps: usize,
+}
+
+/// A spherical embedding of a mesh: one unit vector per vertex.
+#[derive(Clone, Debug)]
+pub struct SphereMap {
+    pub sphere: Vec<Point3>,
+    pub report: ParamReport,
+}
+
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct ParamReport {
+    /// "curvature_flattening" or "tetrahedron" (the fallback when flattening did not reach a star shape).
+    pub method: String,
+    pub working_vertices: usize,
+    pub flatten_rounds: usize,
+    /// Why the fallback was used, if it was.
+    pub fallback_reason: Option<String>,
+    pub vertex_splits: usize,
+    /// Faces of the final map with det ≤ 0 (must be 0).
+    pub foldovers: usize,
+    /// AD, seed 002 eq. IV.64 (radians): mean |angle in 3D − angle of the spherical chord triangle|.
+    pub angle_distortion: f64,
+    /// SD, seed 002 eq. IV.65: Σ |relative 3D area − relative chord-triangle area|, in [0, 2].
+    pub area_distortion: f64,
+}
+
+pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
+    let n = mesh.pos.len();
+    let mut rep = ParamReport::default();
+    let mut h = Hierarchy::new(&mesh.pos, &mesh.tris);
+    h.simplify(s.working_vertices.min(n), true, progress)?;
+    rep.working_vertices = h.alive_vertices;
+    let mut sphere = vec![[0.0; 3]; n];
+    let (map, tris) = h.current();
+    match flatten_to_star(
+        &map.iter().map(|&v| mesh.pos[v as usize]).collect::<Vec<_>>(),
+        &tris,
+        s.max_flatten_rounds,
+        progress,
+    )? {
+        Ok((embedded, rounds)) => {
+            rep.method = "curvature_flattening".into();
+            rep.flatten_rounds = rounds;
+            for (k, &v) in map.iter().enumerate() {
+                sphere[v as usize] = embedded[k];
+            }
+        }
+        Err(reason) => {
+            rep.method = "tetrahedron".into();
+            rep.flatten_rounds = s.max_flatten_rounds;
+            rep.fallback_reason = Some(reason);
+            h.simplify(4, false, progress)?;
+            let (map, tris) = h.current();
+            embed_tetrahedron(&map, &tris, &mut sphere)?;
+        }
+    }
+    // Vertex splits, with relaxation every time the vertex count has grown by 30 %.
+    let total = h.records.len();
+    rep.vertex_splits = total;
+    let mut next_relax = (h.alive_vertices as f64 * 1.3) as usize;
+    let mut done = 0usize;
+    relax(&h, &mesh.pos, &mut sphere, s.relax_sweeps, progress)?;
+    while let Some(rec) = h.split_last() {
+        place_split(&h, rec.vt, rec.vs, &mesh.pos, &mut sphere)?;
+        done += 1;
+        if done % 2048 == 0 {
+            progress.fraction(done as f64 / total.max(1) as f64)?;
+        }
+        if h.alive_vertices >= next_relax {
+            relax(&h, &mesh.pos, &mut sphere, s.relax_sweeps, progress)?;
+            next_relax = (h.alive_vertices as f64 * 1.3) as usize;
+        }
+    }
+    relax(&h, &mesh.pos, &mut sphere, s.final_relax_sweeps, progress)?;
+    rep.foldovers = count_foldovers(&sphere, &mesh.tris);
+    let (ad, sd) = distortion(&mesh.pos, &sphere, &mesh.tris);
+    rep.angle_distortion = ad;
+    rep.area_distortion = sd;
+    Ok(SphereMap { sphere, report: rep })
+}
+
+pub fn count_foldovers(sphere: &[Point3], tris: &[[u32; 3]]) -> usize {
+    tris.iter()
+        .filter(|t| !(orient(sphere[t[0] as usize], sphere[t[1] as usize], sphere[t[2] as usize]) > 0.0))
+        .count()
+}
+
+/// AD and SD of seed 002 eq. IV.64–IV.65 between the 3D mesh and its spherical chord triangles.
+pub fn distortion(pos: &[Point3], sphere: &[Point3], tris: &[[u32; 3]]) -> (f64, f64) {
+    let mut ad = 0.0;
+    let (mut a3, mut a2) = (0.0, 0.0);
+    let areas: Vec<(f64, f64)> = tris
+        .iter()
+        .map(|t| {
+            let p = t.map(|v| pos[v as usize]);
+            let q = t.map(|v| sphere[v as usize]);
+            for k in 0..3 {
+                let a = corner_angle(p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                let b = corner_angle(q[k], q[(k + 1) % 3], q[(k + 2) % 3]);
+                ad += (a - b).abs();
+            }
+            let x = (triangle_area(p[0], p[1], p[2]), triangle_area(q[0], q[1], q[2]));
+            a3 += x.0;
+            a2 += x.1;
+            x
+        })
+        .collect();
+    let sd = areas.iter().map(|&(x, y)| (x / a3.max(1e-300) - y / a2.max(1e-300)).abs()).sum();
+    (ad / (3.0 * tris.len().max(1) as f64), sd)
+}
+
+/// Curvature-driven flattening of a small closed mesh until it is star-shaped about its centre.
+/// Outer Err: cancelled; inner Err: the reason flattening failed.
+#[allow(clippy::type_complexity)]
+fn flatten_to_star(
+    pos0: &[Point3],
+    tris: &[[u32; 3]],
+    max_rounds: usize,
+    progress: &Progress,
+) -> Result<std::result::Result<(Vec<Point3>, usize), String>> {
+    let n = pos0.len();
+    let mut p = pos0.to_vec();
+    let mut vf = vec![Vec::new(); n];
+    for (fi, t) in tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(fi as u32);
+        }
+    }
+    let nbrs: Vec<Vec<u32>> = (0..n)
+        .map(|v| {
+            let mut w: Vec<u32> =
+                vf[v].iter().flat_map(|&f| tris[f as usize]).filter(|&w| w as usize != v).collect();
+            w.sort_unstable();
+            w.dedup();
+            w
+        })
+        .collect();
+    let mut worst = usize::MAX;
+    for round in 1..=max_rounds {
+        progress.fraction(round as f64 / max_rounds as f64)?;
+        // χ_s: average triangle area (eq. IV.62), refreshed each round as the shape shrinks.
+        let chi = tris
+            .iter()
+            .map(|t| triangle_area(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+            .sum::<f64>()
+            / tris.len() as f64;
+        let ks = |p: &[Point3], v: usize| -> f64 {
+            let mut ang = 0.0;
+            let mut area = 0.0;
+            for &f in &vf[v] {
+                let t = tris[f as usize];
+                let k = t.iter().position(|&x| x as usize == v).unwrap_or(0);
+                let (a, b, c) = (p[v], p[t[(k + 1) % 3] as usize], p[t[(k + 2) % 3] as usize]);
+                ang += corner_angle(a, b, c);
+                area += triangle_area(a, b, c);
+            }
+            (2.0 * PI - ang) / (chi + area / 3.0)
+        };
+        let bbox = crate::geometry::Aabb::of(&p).map(|b| b.diagonal()).unwrap_or(1.0);
+        let min_move = 1e-6 * bbox;
+        let mut stamp = vec![0u32; n];
+        let mut heap: BinaryHeap<(Key, u32, u32)> = BinaryHeap::new();
+        for v in 0..n {
+            heap.push((Key(ks(&p, v).abs()), v as u32, 0));
+        }
+        let mut parked = Vec::new();
+        for _ in 0..5 * n {
+            let mut moved = false;
+            while let Some((_, v, st)) = heap.pop() {
+                if stamp[v as usize] != st {
+                    continue;
+                }
+                let v = v as usize;
+                let bary = scale(
+                    nbrs[v].iter().fold([0.0; 3], |s, &w| add(s, p[w as usize])),
+                    1.0 / nbrs[v].len() as f64,
+                );
+                if norm(sub(bary, p[v])) <= min_move {
+                    parked.push(v);
+                    continue;
+                }
+                p[v] = bary;
+                for &w in nbrs[v].iter().chain(std::iter::once(&(v as u32))) {
+                    stamp[w as usize] += 1;
+                    heap.push((Key(ks(&p, w as usize).abs()), w, stamp[w as usize]));
+                }
+                moved = true;
+                break;
+            }
+            for v in parked.drain(..) {
+                heap.push((Key(ks(&p, v).abs()), v as u32, stamp[v]));
+            }
+            if !moved {
+                break;
+            }
+        }
+        // Normalise: centre at the vertex centroid, farthest vertex at radius 1; then the
+        // visibility check (every face positively oriented about the centre).
+        let c = scale(p.iter().fold([0.0; 3], |s, &q| add(s, q)), 1.0 / n as f64);
+        let r = p.iter().map(|&q| norm(sub(q, c))).fold(0.0, f64::max).max(1e-300);
+        for q in &mut p {
+            *q = scale(sub(*q, c), 1.0 / r);
+        }
+        let sph: Vec<Point3> = p.iter().map(|&q| normalize(q)).collect();
+        let bad = count_foldovers(&sph, tris);
+        worst = worst.min(bad);
+        if bad == 0 && sph.iter().all(|q| norm(*q) > 0.5) {
+            return Ok(Ok((sph, round)));
+        }
+    }
+    Ok(Err(format!(
+        "curvature flattening did not reach a star shape in {max_rounds} rounds ({worst} faces still not visible from the centre)"
+    )))
+}
+
+/// Places the 4 vertices of a tetrahedron on a regular tetrahedron, positively oriented.
+fn embed_tetrahedron(map: &[u32], tris: &[[u32; 3]], sphere: &mut [Point3]) -> Result<()> {
+    if map.len() != 4 || tris.len() != 4 {
+        return Err(Error::Internal(format!(
+            "tetrahedron expected, got {} vertices {} faces",
+            map.len(),
+            tris.len()
+        )));
+    }
+    let s = 1.0 / 3f64.sqrt();
+    let mut corners = [[s, s, s], [s, -s, -s], [-s, s, -s], [-s, -s, s]];
+    let t = tris[0];
+    if orient(corners[t[0] as usize], corners[t[1] as usize], corners[t[2] as usize]) < 0.0 {
+        corners.swap(0, 1);
+    }
+    for (k, &v) in map.iter().enumerate() {
+        sphere[v as usize] = corners[k];
+    }
+    for t in tris {
+        let q = t.map(|k| corners[k as usize]);
+        if orient(q[0], q[1], q[2]) <= 0.0 {
+            return Err(Error::Internal("tetrahedron faces inconsistently oriented".into()));
+        }
+    }
+    Ok(())
+}
+
+/// Shape quality of a triangle: 4√3·area / Σ edge², 1 for equilateral, 0 for degenerate.
+#[inline]
+fn quality(a: Point3, b: Point3, c: Point3) -> f64 {
+    let n = norm(cross(sub(b, a), sub(c, a)));
+    let l = dot(sub(b, a), sub(b, a)) + dot(sub(c, b), sub(c, b)) + dot(sub(a, c), sub(a, c));
+    if l <= 0.0 {
+        0.0
+    } else {
+        2.0 * 3f64.sqrt() * n / l
+    }
+}
+
+/// The faces of `v` as (a, b) pairs with (v, a, b) counter-clockwise.
+fn ring_pairs(h: &Hierarchy, v: u32) -> Vec<(u32, u32)> {
+    h.vf[v as usize]
+        .iter()
+        .map(|&f| {
+            let t = h.tris[f as usize];
+            let k = t.iter().position(|&x| x == v).unwrap_or(0);
+            (t[(k + 1) % 3], t[(k + 2) % 3])
+        })
+        .collect()
+}
+
+/// Worst shape quality of the faces around `x` if valid (all positively oriented), else None.
+#[inline]
+fn star_quality(x: Point3, ring: &[(Point3, Point3, Point3)]) -> Option<f64> {
+    let mut q = f64::INFINITY;
+    for &(a, b, n) in ring {
+        if dot(x, n) <= 1e-15 * norm(n) {
+            return None;
+        }
+        q = q.min(quality(x, a, b));
+    }
+    Some(q)
+}
+
+/// Places the vertex `vt` just re-inserted by the split of `vs`.
+fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Point3]) -> Result<()> {
+    let pairs = ring_pairs(h, vt);
+    let ring: Vec<(Point3, Point3, Point3)> = pairs
+        .iter()
+        .map(|&(a, b)| {
+            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+            (pa, pb, cross(pa, pb))
+        })
+        .collect();
+    let mut best: Option<(f64, Point3)> = None;
+    let consider = |best: &mut Option<(f64, Point3)>, x: Point3| {
+        if let Some(q) = star_quality(x, &ring) {
+            if best.is_none_or(|(bq, _)| q > bq) {
+                *best = Some((q, x));
+            }
+        }
+    };
+    // The mean-value target first (it usually wins and lowers distortion), then the lattice over
+    // the fan around vs that covered vt's region before the split, then points ever closer to vs
+    // (the valid region always contains such points, see the module docs).
+    consider(&mut best, mvc_target(h, vt, pos, sphere));
+    let ps = sphere[vs as usize];
+    for &(a, b) in &pairs {
+        if a == vs || b == vs {
+            continue;
+        }
+        let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+        const L: usize = 4;
+        for i in 1..=L {
+            for j in 0..=(L - i) {
+                let k = L - i - j;
+                let x = add(add(scale(ps, i as f64), scale(pa, j as f64)), scale(pb, k as f64));
+                consider(&mut best, normalize(x));
+            }
+        }
+    }
+    // Last resort: every direction around vs at shrinking distances (the valid wedge at vs can be
+    // narrow and lie across a thin fan triangle).
+    let mut eps = 0.25;
+    let e1 =
+        normalize(if ps[0].abs() < 0.9 { cross(ps, [1.0, 0.0, 0.0]) } else { cross(ps, [0.0, 1.0, 0.0]) });
+    let e2 = cross(ps, e1);
+    while best.is_none() && eps > 1e-13 {
+        for d in 0..256 {
+            let th = d as f64 * (2.0 * PI / 256.0);
+            consider(
+                &mut best,
+                normalize(add(ps, add(scale(e1, eps * th.cos()), scale(e2, eps * th.sin())))),
+            );
+        }
+        eps *= 0.25;
+    }
+    let mut eps = 0.25;
+    while best.is_none() && eps > 1e-12 {
+        for &(a, b) in &pairs {
+            if a == vs || b == vs {
+                continue;
+            }
+            // Several directions across the fan triangle: the valid wedge at vs may be narrow.
+            for w in 1..16 {
+                let w = w as f64 / 16.0;
+                let m = add(scale(sphere[a as usize], w), scale(sphere[b as usize], 1.0 - w));
+                consider(&mut best, normalize(add(scale(ps, 1.0 - eps), scale(m, eps))));
+            }
+        }
+        for &(a, b) in &pairs {
+            let other = if a == vs {
+                b
+            } else if b == vs {
+                a
+            } else {
+                continue;
+            };
+            consider(&mut best, normalize(add(scale(ps, 1.0 - eps), scale(sphere[other as usize], eps))));
+        }
+        eps *= 0.25;
+    }
+    match best {
+        Some((_, x)) => {
+            sphere[vt as usize] = x;
+            // The split shrank vs's star: let vs move to its ring's centroid if that improves its
+            // worst triangle (keeps 180° corners from building up).
+            improve_vertex(h, vs, sphere);
+            Ok(())
+        }
+        None => {
+            Err(Error::numerical("parameterise", format!("no valid position found to re-insert vertex {vt}")))
+        }
+    }
+}
+
+/// Moves `v` to the normalised centroid of its ring when that is valid and raises the worst
+/// shape quality of its faces.
+fn improve_vertex(h: &Hierarchy, v: u32, sphere: &mut [Point3]) {
+    let pairs = ring_pairs(h, v);
+    let ring: Vec<(Point3, Point3, Point3)> = pairs
+        .iter()
+        .map(|&(a, b)| {
+            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+            (pa, pb, cross(pa, pb))
+        })
+        .collect();
+    let cur = star_quality(sphere[v as usize], &ring).unwrap_or(-1.0);
+    let c = normalize(ring.iter().fold([0.0; 3], |s, r| add(s, r.0)));
+    if let Some(q) = star_quality(c, &ring) {
+        if q > cur {
+            sphere[v as usize] = c;
+        }
+    }
+}
+
+/// normalize(Σ wᵢⱼ s_j) with Floater's mean-value weights from the 3D mesh.
+fn mvc_target(h: &Hierarchy, v: u32, pos: &[Point3], sphere: &[Point3]) -> Point3 {
+    let pv = pos[v as usize];
+    let mut acc = [0.0; 3];
+    for &f in &h.vf[v as usize] {
+        let t = h.tris[f as usize];
+        let k = t.iter().position(|&x| x == v).unwrap_or(0);
+        let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+        let theta = corner_angle(pv, pos[a as usize], pos[b as usize]);
+        let th = (theta / 2.0).tan();
+        let la = norm(sub(pos[a as usize], pv)).max(1e-300);
+        let lb = norm(sub(pos[b as usize], pv)).max(1e-300);
+        acc = add(acc, scale(sphere[a as usize], th / la));
+        acc = add(acc, scale(sphere[b as usize], th / lb));
+    }
+    normalize(acc)
+}
+
+/// Gauss–Seidel sweeps moving each alive vertex towards its mean-value target, only by moves
+/// that keep every incident face positively oriented (halving the step up to 4 times).
+fn relax(
+    h: &Hierarchy,
+    pos: &[Point3],
+    sphere: &mut [Point3],
+    sweeps: usize,
+    progress: &Progress,
+) -> Result<()> {
+    for _ in 0..sweeps {
+        progress.check()?;
+        for v in 0..h.vertex_alive.len() {
+            if !h.vertex_alive[v] {
+                continue;
+            }
+            let v = v as u32;
+            let target = mvc_target(h, v, pos, sphere);
+            let ring: Vec<(Point3, Point3, Point3)> = ring_pairs(h, v)
+                .iter()
+                .map(|&(a, b)| {
+                    let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+                    (pa, pb, cross(pa, pb))
+                })
+                .collect();
+            let cur = sphere[v as usize];
+            let mut x = target;
+            for _ in 0..5 {
+                if star_quality(x, &ring).is_some_and(|q| q > 1e-3) {
+                    sphere[v as usize] = x;
+                    break;
+                }
+                x = normalize(add(cur, x));
+            }
+        }
+    }
+    Ok(())
+}

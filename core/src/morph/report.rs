@@ -1,0 +1,33 @@
+//! Quality measures of the morph that do not belong to one stage: how well the end frames
+//! reproduce the inputs (symmetric Hausdorff distance, relative to the input's bounding-box
+//! diagonal).
+
+use crate::geometry::Aabb;
+use crate::mesh::Point3;
+use crate::register::surface::SurfaceIndex;
+
+/// One-sided max distance from points (vertices and face centroids of A) to surface B.
+fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &SurfaceIndex) -> f64 {
+    use rayon::prelude::*;
+    let v = pa.par_iter().filter_map(|&p| b.closest(p)).map(|h| h.dist2).reduce(|| 0.0, f64::max);
+    let c = ta
+        .par_iter()
+        .map(|t| {
+            let (x, y, z) = (pa[t[0] as usize], pa[t[1] as usize], pa[t[2] as usize]);
+            [(x[0] + y[0] + z[0]) / 3.0, (x[1] + y[1] + z[1]) / 3.0, (x[2] + y[2] + z[2]) / 3.0]
+        })
+        .filter_map(|p| b.closest(p))
+        .map(|h| h.dist2)
+        .reduce(|| 0.0, f64::max);
+    v.max(c).sqrt()
+}
+
+/// Symmetric Hausdorff distance (sampled at vertices and face centroids) between two triangle
+/// surfaces, divided by the bounding-box diagonal of the second (the reference input).
+pub fn relative_hausdorff(pa: &[Point3], ta: &[[u32; 3]], pb: &[Point3], tb: &[[u32; 3]]) -> f64 {
+    let ia = SurfaceIndex::new(pa, ta);
+    let ib = SurfaceIndex::new(pb, tb);
+    let d = one_sided(pa, ta, &ib).max(one_sided(pb, tb, &ia));
+    let diag = Aabb::of(pb).map(|b| b.diagonal()).unwrap_or(1.0).max(1e-300);
+    d / diag
+}

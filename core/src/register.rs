@@ -1,1 +1,0 @@
-//! Rigid/similarity registration of two meshes or point sets (PCA, ICP, Procrustes).
