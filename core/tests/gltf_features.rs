@@ -326,3 +326,36 @@ fn gltf_json_with_data_uri_and_scene_selection() {
     assert_eq!(l.mesh.vertex_count(), 3);
     assert_eq!(l.mesh.face_count(), 2);
 }
+
+#[test]
+fn quantized_byte_positions_and_normals() {
+    let mut bin = Bin::default();
+    // BYTE normalized, 3-byte elements padded to 4 (byteStride 4, as KHR_mesh_quantization asks).
+    let i8v = bin.view(&[127u8, 128, 0, 0, 64, 0, 129, 0, 0, 0, 0, 0]); // 128 = -128, 129 = -127
+    bin.views[i8v]["byteStride"] = json!(4);
+    // UNSIGNED_BYTE normalized, same layout.
+    let u8v = bin.view(&[255u8, 0, 51, 0, 0, 255, 0, 0, 0, 0, 0, 0]);
+    bin.views[u8v]["byteStride"] = json!(4);
+    // BYTE normalized normals (the same view as the positions: (1, -1, 0) etc. before normalising).
+    let f = single_mesh(
+        &bin,
+        json!([
+            { "bufferView": i8v, "componentType": 5120, "normalized": true, "count": 3, "type": "VEC3" },
+            { "bufferView": u8v, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC3" },
+            { "bufferView": u8v, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC2" }
+        ]),
+        json!([{ "attributes": { "POSITION": 0, "NORMAL": 0, "TEXCOORD_0": 2 } }, { "attributes": { "POSITION": 1, "NORMAL": 0, "TEXCOORD_0": 2 } }]),
+    );
+    let l = load(&f);
+    let p = &l.mesh.positions;
+    // c / 127 clamped to -1; c / 255.
+    assert_eq!(p[0], [1.0, -1.0, 0.0]);
+    assert!(close(p[1], [64.0 / 127.0, 0.0, -1.0]), "{:?}", p[1]);
+    assert_eq!(p[3], [1.0, 0.0, 0.2]);
+    assert_eq!(p[4], [0.0, 1.0, 0.0]);
+    let n = l.mesh.normals.as_ref().unwrap();
+    let s = 1.0 / 2f64.sqrt();
+    assert!(close(n[0], [s, -s, 0.0]), "normals are re-normalised after the transform: {:?}", n[0]);
+    // TEXCOORD_0 (1, 0) in glTF's top-left convention is (1, 1) in meshwork's bottom-left one.
+    assert_eq!(l.mesh.uvs.as_ref().unwrap()[0], [1.0, 1.0]);
+}

@@ -164,3 +164,19 @@ fn generic_io_detects_both_encodings() {
         assert_eq!(loaded.mesh.faces, mesh.faces);
     }
 }
+
+#[test]
+fn faces_gltf_cannot_hold_are_an_error_not_a_silent_drop() {
+    let mut faces = Faces::new();
+    faces.push(&[0, 1, 2], 0);
+    faces.push(&[1, 2], 0);
+    let mesh = Mesh::new(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], faces);
+    let err = write_glb(&mesh).unwrap_err();
+    assert!(
+        matches!(
+            &err,
+            meshwork_core::Error::InvalidMesh { location: meshwork_core::error::Location::Face(1), .. }
+        ),
+        "{err}"
+    );
+}

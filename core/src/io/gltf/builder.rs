@@ -348,8 +348,6 @@ pub struct AddedMesh {
     pub meshes: Vec<usize>,
     /// Nodes created (one per glTF mesh, each a scene root with the same name).
     pub nodes: Vec<usize>,
-    /// Faces with fewer than 3 vertices, which glTF cannot hold.
-    pub skipped_faces: usize,
 }
 
 /// Adds `mesh` to the builder in meshwork's layout; see [`super::write`] for the layout and

@@ -43,6 +43,11 @@ pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
     let root = object(&root, "(root)")?;
     check_asset(root)?;
     let mut reader = Reader::new(root, bin, opts)?;
+    if array(root, "extensionsUsed", "")?.iter().any(|e| e.as_str() == Some("EXT_mesh_gpu_instancing")) {
+        reader.warnings.push(
+            "EXT_mesh_gpu_instancing: instances are not expanded, each mesh is read once per node".into(),
+        );
+    }
     let instances = reader.instances()?;
     let mesh = reader.flatten(&instances)?;
     Ok(Loaded { mesh, format, warnings: reader.warnings })

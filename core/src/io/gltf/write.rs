@@ -6,9 +6,10 @@
 //!   glTF's origin is top-left). Vertex order is kept, so vertex `i` stays vertex `i`;
 //! - one glTF mesh per non-empty face group, named after the group, with one TRIANGLES primitive,
 //!   and one node of the same name per mesh. Polygons are fan-triangulated (glTF has no quads);
-//!   faces with fewer than 3 vertices cannot be written and are counted in
-//!   [`AddedMesh::skipped_faces`]. Faces come out grouped by group id;
-//! - curves (≥ 2 vertices) as LINE_STRIP primitives of one extra mesh named `curves`;
+//!   a face with fewer than 3 vertices cannot be written: that is an error (`invalid-mesh` naming
+//!   the face; repair drops such faces), not a silent drop. Faces come out grouped by group id;
+//! - curves as LINE_STRIP primitives of one extra mesh named `curves` (a curve of fewer than 2
+//!   vertices has no segment and is left out; its vertices are still written);
 //! - a mesh with vertices but neither faces nor curves is written as one POINTS primitive.
 //!
 //! Positions are f32 in glTF: coordinates round to about 7 significant digits.
@@ -16,7 +17,7 @@
 use serde_json::json;
 
 use super::builder::{GltfBuilder, MODE_LINE_STRIP, MODE_TRIANGLES};
-use crate::error::Result;
+use crate::error::{Error, Location, Result};
 use crate::mesh::Mesh;
 
 pub use super::builder::AddedMesh;
@@ -35,22 +36,23 @@ fn unit_f32(n: [f64; 3]) -> [f32; 3] {
     }
 }
 
-/// Fan-triangulated faces per group id; returns (triangles per group, faces skipped).
-fn triangles_by_group(mesh: &Mesh) -> (Vec<Vec<u32>>, usize) {
+/// Fan-triangulated faces per group id.
+fn triangles_by_group(mesh: &Mesh) -> Result<Vec<Vec<u32>>> {
     let group_count = mesh.faces.groups().iter().map(|&g| g as usize + 1).max().unwrap_or(0);
     let mut by_group = vec![Vec::new(); group_count.max(mesh.groups.len())];
-    let mut skipped = 0;
     for (fi, face) in mesh.faces.iter().enumerate() {
         if face.len() < 3 {
-            skipped += 1;
-            continue;
+            return Err(Error::InvalidMesh {
+                location: Location::Face(fi),
+                message: format!("a face with {} vertices cannot be written to glTF", face.len()),
+            });
         }
         let tris = &mut by_group[mesh.faces.group(fi) as usize];
         for k in 1..face.len() - 1 {
             tris.extend_from_slice(&[face[0], face[k], face[k + 1]]);
         }
     }
-    (by_group, skipped)
+    Ok(by_group)
 }
 
 pub(super) fn add_mesh(b: &mut GltfBuilder, mesh: &Mesh) -> Result<AddedMesh> {
@@ -92,7 +94,7 @@ pub(super) fn add_mesh(b: &mut GltfBuilder, mesh: &Mesh) -> Result<AddedMesh> {
         added.nodes.push(ni);
     };
 
-    let (by_group, skipped) = triangles_by_group(mesh);
+    let by_group = triangles_by_group(mesh)?;
     for (g, tris) in by_group.iter().enumerate() {
         if tris.is_empty() {
             continue;
@@ -115,7 +117,6 @@ pub(super) fn add_mesh(b: &mut GltfBuilder, mesh: &Mesh) -> Result<AddedMesh> {
     if by_group.iter().all(|t| t.is_empty()) && curve_prims_written == 0 {
         push_mesh(b, "points", vec![json!({ "attributes": attributes, "mode": MODE_POINTS })]);
     }
-    added.skipped_faces = skipped;
     Ok(added)
 }
 
