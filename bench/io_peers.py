@@ -37,3 +37,7 @@ for path in sys.argv[1:]:
     out = os.path.join(tempfile.gettempdir(), '_trimesh_out.glb')
     dw, _ = best(lambda: m.export(out))
     print(f"{name}\twrite_glb\ttrimesh\t{dw*1e3:.1f}", flush=True)
+    if name.endswith('.obj'):
+        out = os.path.join(tempfile.gettempdir(), '_trimesh_out.obj')
+        dw, _ = best(lambda: m.export(out))
+        print(f"{name}\twrite_obj\ttrimesh\t{dw*1e3:.1f}", flush=True)

@@ -155,3 +155,15 @@ fn detection_by_content_then_name() {
     assert_eq!(detect(b"\x00\x01garbage", None).unwrap_err().kind(), "unsupported-format");
     assert_eq!(detect(b"", None).unwrap_err().kind(), "malformed-input");
 }
+
+#[test]
+fn gltf_json_is_detected_and_read_through_io_read() {
+    // The glTF writer's JSON output must come back through content detection (`{` + "asset").
+    let m = shapes::icosphere(1, 1.0);
+    let b = io::write(&m, Format::Gltf).unwrap();
+    assert_eq!(detect(&b, None).unwrap(), Format::Gltf);
+    let l = read(&b);
+    assert_eq!(l.format, Format::Gltf);
+    assert_eq!(l.mesh.vertex_count(), m.vertex_count());
+    assert_eq!(l.mesh.faces, m.faces);
+}

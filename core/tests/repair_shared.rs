@@ -154,6 +154,9 @@ fn beetle_tangle_does_not_panic_and_ends_without_non_manifold_edges() {
     let r = analyze(&out);
     assert_eq!(r.non_manifold_edges, 0, "{rep}");
     assert_eq!(r.non_manifold_vertices, 0, "{rep}");
+    // Split copies sit on the original positions; hole patches must not make zero-area faces
+    // between them.
+    assert_eq!(r.degenerate_faces, 0, "{rep}");
 }
 
 // ---- analytic shapes -------------------------------------------------------------------
@@ -282,4 +285,39 @@ fn require_manifold_fails_with_reason() {
         Err(meshwork_core::Error::Topology(msg)) => assert!(msg.contains("non-manifold vertices"), "{msg}"),
         other => panic!("{other:?}"),
     }
+}
+
+#[test]
+fn empty_and_all_degenerate_inputs_do_not_panic() {
+    let empty = Mesh::default();
+    let r = job::run(JobKind::Validate, vec![empty.clone()], Value::Null, &Progress::new()).unwrap().report;
+    assert_eq!(r["faces"], 0);
+    assert_eq!(r["closed"], false);
+    let (out, _) = repair(empty, Value::Null);
+    assert_eq!(out.face_count(), 0);
+    let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+    let m = Mesh::from_triangles(p, &[[0, 1, 2], [0, 0, 1], [1, 1, 1]]);
+    let (out, rep) = repair(m, Value::Null);
+    assert_eq!(out.face_count(), 0);
+    assert_eq!(out.vertex_count(), 0);
+    assert_eq!(rep["steps"]["clean"]["dropped_zero_area"], 1);
+    assert_eq!(rep["steps"]["clean"]["dropped_repeated_index"], 2);
+}
+
+#[test]
+fn face_groups_survive_and_patches_take_their_neighbours_group() {
+    let (mut m, _) = capped(3, 30.0);
+    // Group 1 = southern hemisphere, group 0 = the rest (the hole is in the north).
+    let mut faces = Faces::new();
+    for f in m.faces.iter() {
+        let south = f.iter().all(|&v| m.positions[v as usize][2] < 0.0);
+        faces.push(f, u32::from(south));
+    }
+    let south = faces.groups().iter().filter(|&&g| g == 1).count();
+    m.faces = faces;
+    m.groups = vec!["north".into(), "south".into()];
+    let (out, rep) = repair(m, Value::Null);
+    assert_eq!(rep["steps"]["fill_holes"]["filled"], 1);
+    assert_eq!(out.faces.groups().iter().filter(|&&g| g == 1).count(), south);
+    assert_eq!(out.groups, vec!["north".to_string(), "south".to_string()]);
 }

@@ -258,17 +258,23 @@ fn parse_normal(c: &mut Chunk, mut toks: Tokens, n: usize) -> Result<()> {
 }
 
 /// One OBJ index (1-based, or negative = counted back from the last element defined so far).
+#[inline]
 fn parse_index(tok: &[u8], local_count: usize, what: &str, n: usize) -> Result<Index> {
+    match lex::parse_i64(tok) {
+        // The common case, kept small so it inlines into the face loop.
+        Some(v) if v > 0 && v <= u32::MAX as i64 => Ok(Index::Abs((v - 1) as u32)),
+        _ => parse_index_rare(tok, local_count, what, n),
+    }
+}
+
+#[cold]
+fn parse_index_rare(tok: &[u8], local_count: usize, what: &str, n: usize) -> Result<Index> {
     let v = lex::parse_i64(tok).ok_or_else(|| {
         malformed(n, format!("{what} index `{}` is not an integer", String::from_utf8_lossy(tok)))
     })?;
     match v {
         0 => Err(invalid(n, format!("{what} index 0 (OBJ indices start at 1)"))),
-        v if v > 0 => u32::try_from(v - 1)
-            .ok()
-            .filter(|&i| i != NONE)
-            .map(Index::Abs)
-            .ok_or_else(|| invalid(n, format!("{what} index {v} out of range"))),
+        v if v > 0 => Err(invalid(n, format!("{what} index {v} out of range"))),
         v => Ok(Index::Rel(local_count as i64 + v)),
     }
 }
@@ -286,12 +292,15 @@ fn place(c: &mut Chunk, idx: Index, slot: Slot, pos: usize, n: usize) -> u32 {
 }
 
 /// Splits `v`, `v/vt`, `v//vn` or `v/vt/vn`.
+#[inline]
 fn split_corner(tok: &[u8]) -> (&[u8], Option<&[u8]>, Option<&[u8]>) {
-    let mut parts = tok.splitn(3, |&b| b == b'/');
-    let v = parts.next().unwrap_or(b"");
-    let vt = parts.next().filter(|p| !p.is_empty());
-    let vn = parts.next().filter(|p| !p.is_empty());
-    (v, vt, vn)
+    let Some(a) = tok.iter().position(|&b| b == b'/') else { return (tok, None, None) };
+    let rest = &tok[a + 1..];
+    let (vt, vn) = match rest.iter().position(|&b| b == b'/') {
+        Some(b) => (&rest[..b], Some(&rest[b + 1..])),
+        None => (rest, None),
+    };
+    (&tok[..a], Some(vt).filter(|t| !t.is_empty()), vn.filter(|t| !t.is_empty()))
 }
 
 fn parse_face(c: &mut Chunk, toks: Tokens, n: usize) -> Result<()> {
@@ -534,7 +543,8 @@ impl<'a> Stitcher<'a> {
         if group_names.len() == 1 && group_names[0].is_empty() || faces.is_empty() {
             group_names.clear();
         }
-        let degenerate = faces.iter().filter(|f| distinct_count(f) < 3).count();
+        let degenerate =
+            (0..faces.len()).into_par_iter().filter(|&i| distinct_count(faces.get(i)) < 3).count();
         if degenerate > 0 {
             warnings.push(format!(
                 "{degenerate} faces repeat a vertex (fewer than 3 distinct); kept for validate/repair"

@@ -6,7 +6,7 @@
 //! the mesh has connectivity, and says how many corners were merged.
 
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 use super::lex::{self, Tokens};
 use super::{Format, Loaded, ReadOptions};
@@ -53,6 +53,8 @@ fn starts_with_solid(bytes: &[u8]) -> bool {
 #[derive(Default)]
 struct Soup {
     corners: Vec<[f64; 3]>,
+    /// Every coordinate came from an f32 (binary STL): weld on the 12-byte f32 key.
+    from_f32: bool,
     /// Corners per facet (3 for binary).
     arity: Vec<u32>,
     groups: Vec<u32>,
@@ -78,7 +80,8 @@ fn read_binary(bytes: &[u8], opts: &ReadOptions) -> Result<Soup> {
         ));
     }
     let n = n as usize; // the size check above bounds n by the file length
-    let mut soup = Soup { corners: Vec::with_capacity(3 * n), arity: vec![3; n], groups: vec![0; n] };
+    let mut soup =
+        Soup { corners: Vec::with_capacity(3 * n), from_f32: true, arity: vec![3; n], groups: vec![0; n] };
     for (t, rec) in bytes[84..].chunks_exact(50).enumerate() {
         for k in 0..3 {
             let at = 12 + 12 * k;
@@ -172,39 +175,62 @@ fn read_ascii(bytes: &[u8], opts: &ReadOptions) -> Result<(Soup, Vec<String>)> {
     Ok((soup, groups))
 }
 
-/// A fast hasher for exact coordinate bit patterns (SipHash is needlessly slow here, and the
-/// keys are not attacker-chosen in a way that matters: worst case is a slow weld, not a crash).
+/// A fast hasher for exact coordinate bit patterns (SipHash is needlessly slow here). Values are
+/// combined with a multiply and finished with the splitmix64 mixer, so coordinates whose low
+/// mantissa bits are all zero (0.5, 1.25, …: common in hand-made files) still spread over buckets.
 #[derive(Default)]
 struct BitsHasher(u64);
 
 impl Hasher for BitsHasher {
     fn finish(&self) -> u64 {
-        self.0
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
     }
     fn write(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.write_u64(b as u64);
         }
     }
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
     fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+        self.0 = (self.0.rotate_left(23) ^ v).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+}
+
+/// Exact f32 coordinates as a weld key (-0 mapped to +0), hashed as two words.
+#[derive(PartialEq, Eq)]
+struct Key32([u32; 3]);
+
+impl Hash for Key32 {
+    fn hash<H: Hasher>(&self, h: &mut H) {
+        h.write_u64(self.0[0] as u64 | (self.0[1] as u64) << 32);
+        h.write_u64(self.0[2] as u64);
+    }
+}
+
+/// Exact f64 coordinates as a weld key (-0 mapped to +0).
+#[derive(PartialEq, Eq)]
+struct Key64([u64; 3]);
+
+impl Hash for Key64 {
+    fn hash<H: Hasher>(&self, h: &mut H) {
+        for v in self.0 {
+            h.write_u64(v);
+        }
     }
 }
 
 /// Merges exactly coincident corners into shared vertices (first occurrence order).
 fn weld(soup: Soup, groups: Vec<String>) -> Loaded {
-    let mut map: HashMap<[u64; 3], u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
-    map.reserve(soup.corners.len() / 2);
-    let mut positions = Vec::with_capacity(soup.corners.len() / 2);
-    let mut index = Vec::with_capacity(soup.corners.len());
-    for p in &soup.corners {
-        let key = p.map(|c| (c + 0.0).to_bits()); // -0.0 + 0.0 = +0.0
-        let id = *map.entry(key).or_insert_with(|| {
-            positions.push(*p);
-            (positions.len() - 1) as u32
-        });
-        index.push(id);
-    }
+    let (positions, index) = if soup.from_f32 {
+        weld_by(&soup.corners, |p| Key32(p.map(|c| (c as f32 + 0.0).to_bits())))
+    } else {
+        weld_by(&soup.corners, |p| Key64(p.map(|c| (c + 0.0).to_bits())))
+    };
     let mut faces = Faces::with_capacity(soup.arity.len(), index.len());
     let mut start = 0;
     for (&k, &g) in soup.arity.iter().zip(&soup.groups) {
@@ -218,6 +244,23 @@ fn weld(soup: Soup, groups: Vec<String>) -> Loaded {
     )];
     let groups = if groups.len() > 1 { groups } else { Vec::new() };
     Loaded { mesh: Mesh { positions, faces, groups, ..Default::default() }, format: Format::Stl, warnings }
+}
+
+/// Positions in first-occurrence order and each corner's vertex id. A closed triangle mesh has
+/// about one vertex per 6 corners, which sizes the table (it grows if there are more).
+fn weld_by<K: Hash + Eq>(corners: &[[f64; 3]], key: impl Fn(&[f64; 3]) -> K) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let mut map: HashMap<K, u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
+    map.reserve(corners.len() / 6 + 16);
+    let mut positions = Vec::with_capacity(corners.len() / 6 + 16);
+    let mut index = Vec::with_capacity(corners.len());
+    for p in corners {
+        let id = *map.entry(key(p)).or_insert_with(|| {
+            positions.push(*p);
+            (positions.len() - 1) as u32
+        });
+        index.push(id);
+    }
+    (positions, index)
 }
 
 /// Encodes `mesh` as binary STL: polygons are fan-triangulated (STL holds only triangles),

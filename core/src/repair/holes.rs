@@ -254,6 +254,10 @@ fn liepa_dp(
     }
     let tri_normal =
         |i: usize, m: usize, k: usize| normalize(cross(sub(pos[m], pos[i]), sub(pos[k], pos[i])));
+    // Zero-area triangles (coincident or collinear loop vertices, e.g. a vertex next to its own
+    // split copy) are not allowed: their normal is undefined and they would be degenerate faces.
+    let perimeter: f64 = (0..n).map(|i| dist(pos[i], pos[(i + 1) % n])).sum();
+    let min_area = 1e-12 * perimeter * perimeter;
     for len in 2..n {
         if len % 16 == 0 {
             progress.check()?;
@@ -286,6 +290,9 @@ fn liepa_dp(
                     worst = worst.max(1.0 - dot(nt, nb[n - 1]));
                 }
                 let area = 0.5 * norm(cross(sub(pos[m], pos[i]), sub(pos[k], pos[i])));
+                if !(area > min_area) {
+                    continue;
+                }
                 let cand = wl.plus(wr).plus(Weight(worst, area));
                 if cand < best {
                     best = cand;
@@ -430,7 +437,13 @@ impl Patch {
                     }
                     let p = |v: u32| self.pos[v as usize];
                     let opp = corner_angle(p(c), p(a), p(b)) + corner_angle(p(d), p(b), p(a));
-                    if opp > std::f64::consts::PI + 1e-9 {
+                    // Flip only into two proper triangles facing the same way (the quad a-d-b-c is
+                    // convex): never onto coincident points or across a fold.
+                    let n1 = cross(sub(p(a), p(c)), sub(p(d), p(c)));
+                    let n2 = cross(sub(p(b), p(d)), sub(p(c), p(d)));
+                    let scale2 = crate::geometry::norm2(sub(p(a), p(b)));
+                    let proper = norm(n1) > 1e-12 * scale2 && norm(n2) > 1e-12 * scale2 && dot(n1, n2) > 0.0;
+                    if proper && opp > std::f64::consts::PI + 1e-9 {
                         self.tris[t1] = [c, a, d];
                         self.tris[t2] = [d, b, c];
                         touched[t1] = true;
