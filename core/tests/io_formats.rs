@@ -135,10 +135,15 @@ fn stl_ascii_hand_written() {
     let src = "solid tet\n facet normal 0 0 -1\n  outer loop\n   vertex 0 0 0\n   vertex 0 1 0\n   vertex 1 0 0\n\
                endloop\n endfacet\n facet normal 0 -1 0\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 0 0 1\n\
                endloop\n endfacet\nendsolid tet\n";
-    let l = read(src.as_bytes());
-    assert_eq!(l.format, Format::Stl);
-    assert_eq!(l.mesh.positions, vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
-    assert_eq!(l.mesh.faces, Faces::from_triangles(&[[0, 1, 2], [0, 2, 3]]));
+    for src in [src.to_string(), src.to_uppercase().replace("\n", "\r\n")] {
+        let l = read(src.as_bytes());
+        assert_eq!(l.format, Format::Stl);
+        assert_eq!(
+            l.mesh.positions,
+            vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+        );
+        assert_eq!(l.mesh.faces, Faces::from_triangles(&[[0, 1, 2], [0, 2, 3]]));
+    }
 }
 
 #[test]

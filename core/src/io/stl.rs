@@ -29,11 +29,11 @@ fn binary_count(bytes: &[u8]) -> Option<u64> {
 pub(crate) fn looks_ascii(bytes: &[u8]) -> bool {
     let t = &bytes[bytes.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(bytes.len())..];
     let head = &t[..t.len().min(1024)];
-    head.len() >= 5
-        && head[..5].eq_ignore_ascii_case(b"solid")
+    let head = head.to_ascii_lowercase(); // some exporters write `SOLID`, `FACET NORMAL`
+    head.starts_with(b"solid")
         && head.iter().all(|&b| b.is_ascii_graphic() || b.is_ascii_whitespace())
-        && (memchr::memmem::find(head, b"facet").is_some()
-            || memchr::memmem::find(head, b"endsolid").is_some())
+        && (memchr::memmem::find(&head, b"facet").is_some()
+            || memchr::memmem::find(&head, b"endsolid").is_some())
 }
 
 /// Decodes STL bytes.
@@ -117,11 +117,12 @@ fn read_ascii(bytes: &[u8], opts: &ReadOptions) -> Result<(Soup, Vec<String>)> {
     for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
         let n = i + 1;
         let mut t = Tokens::new(line);
-        let key = t.next();
+        // Keywords are matched case-insensitively: some exporters write `FACET NORMAL`.
+        let key = t.next().map(|k| k.to_ascii_lowercase());
         if key.is_some() {
             last = n; // the last line with content, where a truncated file "ends"
         }
-        match key {
+        match key.as_deref() {
             None => {}
             Some(b"solid") if !in_solid => {
                 in_solid = true;
