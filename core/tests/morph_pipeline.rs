@@ -268,3 +268,57 @@ fn morph_glb_passes_the_khronos_validator() {
     assert_eq!(doc["animations"][0]["channels"][0]["target"]["path"], "weights");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// An icosphere with two holes (faces removed) and a non-manifold edge (a fin triangle on an
+/// existing edge), as a segmentation might deliver it.
+fn damaged_sphere() -> Mesh {
+    let m = shapes::icosphere(3, 1.0);
+    let mut tris = shapes::fan_triangles(&m.faces);
+    let fin_edge = (tris[0][0], tris[0][1]);
+    tris.remove(300);
+    tris.remove(100);
+    let mut pos = m.positions.clone();
+    pos.push([1.5, 0.2, 0.1]);
+    tris.push([fin_edge.0, fin_edge.1, (pos.len() - 1) as u32]);
+    Mesh::from_triangles(pos, &tris)
+}
+
+#[test]
+fn damaged_input_is_refused_then_morphed_after_repair() {
+    let b = ellipsoid(2, [1.0, 1.5, 0.8]);
+    let e =
+        job::run(JobKind::Morph, vec![damaged_sphere(), b.clone()], serde_json::json!({}), &Progress::new())
+            .expect_err("holes and a non-manifold edge");
+    match &e {
+        Error::Topology(msg) => assert!(msg.contains("input 0") && msg.contains("non-manifold"), "{msg}"),
+        other => panic!("wrong error: {other}"),
+    }
+    let out = job::run(
+        JobKind::Morph,
+        vec![damaged_sphere(), b],
+        serde_json::json!({"repair": true, "frames": 3}),
+        &Progress::new(),
+    )
+    .expect("morph after repair");
+    assert_eq!(out.report["foldovers"], serde_json::json!([0, 0]));
+    assert!(out.report["hausdorff_first_frame"].as_f64().unwrap() < 1e-9, "{}", out.report);
+    assert_eq!(out.report["repair"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn blend_weights_give_the_affine_combination_of_the_remeshed_inputs() {
+    let inputs =
+        || vec![shapes::icosphere(2, 1.0), ellipsoid(2, [2.0, 1.0, 1.0]), ellipsoid(1, [1.0, 1.0, 2.0])];
+    let full = job::run(JobKind::Morph, inputs(), serde_json::json!({}), &Progress::new()).expect("morph");
+    let w = [0.2, 0.5, 0.3];
+    let blend = job::run(JobKind::Morph, inputs(), serde_json::json!({"blend_weights": w}), &Progress::new())
+        .expect("blend");
+    assert_eq!(full.meshes.len(), 3);
+    assert_eq!(blend.meshes.len(), 1);
+    for (i, p) in blend.meshes[0].positions.iter().enumerate() {
+        for c in 0..3 {
+            let want: f64 = (0..3).map(|k| w[k] * full.meshes[k].positions[i][c]).sum();
+            assert!((p[c] - want).abs() < 1e-12, "vertex {i}");
+        }
+    }
+}

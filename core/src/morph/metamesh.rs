@@ -15,6 +15,7 @@
 //! which is how 3+ inputs are merged (multi-morph).
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use crate::error::{Error, Result};
 use crate::geometry::{add, cross, dot, normalize, scale, sub};
@@ -23,6 +24,31 @@ use crate::mesh::Point3;
 
 use super::correspond::{bary_on_chord, interpolate, Locator};
 use super::param::orient;
+
+/// FxHash (rustc's hasher): the overlay hashes millions of small integer labels, where SipHash's
+/// DoS resistance buys nothing and costs most of the stage's time.
+#[derive(Default)]
+struct Fx(u64);
+impl Hasher for Fx {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+}
+type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<Fx>>;
 
 /// A spherical triangulation carrying one 3D position per vertex for each input shape.
 #[derive(Clone, Debug)]
@@ -112,7 +138,8 @@ pub struct OverlayReport {
 pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, OverlayReport)> {
     let nbr_b = super::trimesh::TriMesh { pos: b.sphere.clone(), tris: b.tris.clone() }.face_neighbours();
     let mut loc = Locator::new(&b.sphere, &b.tris, nbr_b.clone());
-    let mut ids: HashMap<Label, u32> = HashMap::with_capacity((a.sphere.len() + b.sphere.len()) * 3);
+    let mut ids: FxMap<Label, u32> =
+        FxMap::with_capacity_and_hasher((a.sphere.len() + b.sphere.len()) * 3, Default::default());
     let mut sphere: Vec<Point3> = Vec::new();
     let ka = a.shapes.len();
     let mut shapes: Vec<Vec<Point3>> = vec![Vec::new(); ka + b.shapes.len()];
@@ -272,7 +299,8 @@ fn push_shapes(
 
 /// Every directed edge must appear once, together with its reverse.
 fn check_closed_manifold(tris: &[[u32; 3]], nv: usize) -> Result<()> {
-    let mut half: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3);
+    let mut half: FxMap<(u32, u32), u32> =
+        FxMap::with_capacity_and_hasher(tris.len() * 3, Default::default());
     for t in tris {
         for k in 0..3 {
             *half.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;

@@ -187,7 +187,55 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     let k_in = inputs.len();
     let mut stages = Stages::new();
 
-    // 1. Validate (and optionally repair).
+    // 0. Optional repair (seed 003 §4.2: non-manifold parts, isolated pieces, holes), keeping
+    //    track of where each input vertex went so feature indices still mean the same vertex.
+    let mut repair_reports: Vec<serde_json::Value> = Vec::new();
+    let mut repair_maps: Vec<Option<Vec<u32>>> = vec![None; k_in];
+    let inputs: Vec<Mesh> = if params.repair {
+        stages.run(progress, "repair", || {
+            let rp = crate::repair::RepairParams {
+                keep_largest: true,
+                report_vertex_map: true,
+                ..Default::default()
+            };
+            let mut out = Vec::with_capacity(k_in);
+            for (k, m) in inputs.into_iter().enumerate() {
+                if m.positions.len() > params.max_vertices {
+                    return Err(Error::TooLarge {
+                        what: format!("{} vertices", input_name(k)),
+                        limit: params.max_vertices as u64,
+                        actual: m.positions.len() as u64,
+                    });
+                }
+                let r = crate::repair::run(m, &rp, progress)?;
+                let map: Vec<u32> = r.report["vertex_map"]["map"]
+                    .as_array()
+                    .map(|a| {
+                        a.iter()
+                            .map(|x| x.as_i64().filter(|&v| v >= 0).map_or(u32::MAX, |v| v as u32))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                repair_maps[k] = Some(map);
+                let mut rep = r.report;
+                if let Some(vm) = rep.get_mut("vertex_map").and_then(|v| v.as_object_mut()) {
+                    vm.remove("map");
+                }
+                repair_reports.push(rep);
+                out.push(
+                    r.meshes
+                        .into_iter()
+                        .next()
+                        .ok_or_else(|| Error::Internal("repair returned no mesh".into()))?,
+                );
+            }
+            Ok(out)
+        })?
+    } else {
+        inputs
+    };
+
+    // 1. Validate.
     let (meshes, maps, conv_reports, topo) = stages.run(progress, "validate", || {
         let mut meshes = Vec::new();
         let mut maps = Vec::new();
@@ -200,12 +248,6 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
                     limit: params.max_vertices as u64,
                     actual: m.positions.len() as u64,
                 });
-            }
-            if params.repair {
-                return Err(Error::params(
-                    "repair",
-                    "repair before morphing is not available in this build yet",
-                ));
             }
             let (mut t, map, conv) = TriMesh::from_mesh(m);
             let info = trimesh::topology(&t);
@@ -220,6 +262,20 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             convs.push(json!({"conversion": conv, "orientation_flipped": flipped}));
             topo.push(info);
             meshes.push(t);
+            // Input vertex → triangulated vertex, through the repair's map when there was one.
+            let map = match &repair_maps[k] {
+                Some(rm) => rm
+                    .iter()
+                    .map(|&r| {
+                        if r == u32::MAX {
+                            u32::MAX
+                        } else {
+                            map.get(r as usize).copied().unwrap_or(u32::MAX)
+                        }
+                    })
+                    .collect(),
+                None => map,
+            };
             maps.push(map);
         }
         Ok((meshes, maps, convs, topo))
@@ -235,7 +291,10 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             if m == u32::MAX {
                 return Err(Error::params(
                     format!("features[{i}][{k}]"),
-                    format!("vertex {v} of {} does not exist or is used by no face", input_name(k)),
+                    format!(
+                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
+                        input_name(k)
+                    ),
                 ));
             }
             row.push(m);
@@ -391,6 +450,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
                     &layer.tris,
                     &normalised[k].pos,
                     &normalised[k].tris,
+                    // Overlay faces lie inside input faces: their vertices bound the distance.
+                    overlay_reps.len() + 1 < k_in || params.correspondence == Correspondence::Transfer,
                 )
             })
             .collect::<Vec<f64>>())
@@ -431,6 +492,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "frames": params.frames,
         "output_meshes": if params.blend_weights.is_some() { "blend" } else if params.output_frames { "frames" } else { "remeshed_inputs" },
         "per_input": per_input,
+        "repair": repair_reports,
         "total_ms": stages.total_ms(),
         "stages": stages.to_json(),
     });

@@ -81,13 +81,52 @@ pub struct ParamReport {
     pub angle_distortion: f64,
     /// SD, seed 002 eq. IV.65: Σ |relative 3D area − relative chord-triangle area|, in [0, 2].
     pub area_distortion: f64,
+    /// Earlier attempts that failed (settings and reason), when the first did not succeed.
+    pub retries: Vec<String>,
+    /// Wall time of the sub-steps, in run order.
+    pub timings_ms: Vec<(String, f64)>,
 }
 
+/// Parameterises, retrying with other settings when a vertex split finds no valid position
+/// (thin spherical triangles can leave a numerically empty kernel): first as asked, then from a
+/// tetrahedron, then with half and double the working size. The report names the retries.
 pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
+    let mut tries = vec![s.clone()];
+    if s.max_flatten_rounds > 0 {
+        tries.push(ParamSettings { working_vertices: 4, max_flatten_rounds: 0, ..s.clone() });
+    }
+    tries.push(ParamSettings { working_vertices: (s.working_vertices / 2).max(4), ..s.clone() });
+    tries.push(ParamSettings { working_vertices: s.working_vertices * 2, ..s.clone() });
+    let mut failures = Vec::new();
+    for t in &tries {
+        match parameterise_once(mesh, t, progress) {
+            Ok(mut m) => {
+                m.report.retries = failures;
+                return Ok(m);
+            }
+            Err(Error::Numerical { message, .. }) => failures.push(format!(
+                "working_vertices {}, flatten rounds {}: {message}",
+                t.working_vertices, t.max_flatten_rounds
+            )),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(Error::numerical("parameterise", failures.join("; ")))
+}
+
+fn parameterise_once(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
     let n = mesh.pos.len();
     let mut rep = ParamReport::default();
     let mut h = Hierarchy::new(&mesh.pos, &mesh.tris);
+    let clock = std::time::Instant::now();
+    let lap = |t: &mut std::time::Instant| -> f64 {
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        *t = std::time::Instant::now();
+        (ms * 1e3).round() / 1e3
+    };
+    let mut t = clock;
     h.simplify(s.working_vertices.min(n), true, progress)?;
+    rep.timings_ms.push(("simplify".into(), lap(&mut t)));
     rep.working_vertices = h.alive_vertices;
     let mut sphere = vec![[0.0; 3]; n];
     let (map, tris) = h.current();
@@ -113,6 +152,8 @@ pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> R
             embed_tetrahedron(&map, &tris, &mut sphere)?;
         }
     }
+    rep.timings_ms.push(("embed".into(), lap(&mut t)));
+    let mut relax_ms = 0.0;
     // Vertex splits, with relaxation every time the vertex count has grown by 30 %.
     let total = h.records.len();
     rep.vertex_splits = total;
@@ -126,11 +167,17 @@ pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> R
             progress.fraction(done as f64 / total.max(1) as f64)?;
         }
         if h.alive_vertices >= next_relax {
+            let r = std::time::Instant::now();
             relax(&h, &mesh.pos, &mut sphere, s.relax_sweeps, progress)?;
+            relax_ms += r.elapsed().as_secs_f64() * 1e3;
             next_relax = (h.alive_vertices as f64 * 1.3) as usize;
         }
     }
+    let splits = lap(&mut t);
+    rep.timings_ms.push(("vertex_splits".into(), ((splits - relax_ms) * 1e3).round() / 1e3));
+    rep.timings_ms.push(("relax_during_splits".into(), (relax_ms * 1e3).round() / 1e3));
     relax(&h, &mesh.pos, &mut sphere, s.final_relax_sweeps, progress)?;
+    rep.timings_ms.push(("final_relax".into(), lap(&mut t)));
     rep.foldovers = count_foldovers(&sphere, &mesh.tris);
     let (ad, sd) = distortion(&mesh.pos, &sphere, &mesh.tris);
     rep.angle_distortion = ad;
@@ -328,7 +375,7 @@ fn ring_pairs(h: &Hierarchy, v: u32) -> Vec<(u32, u32)> {
 fn star_quality(x: Point3, ring: &[(Point3, Point3, Point3)]) -> Option<f64> {
     let mut q = f64::INFINITY;
     for &(a, b, n) in ring {
-        if dot(x, n) <= 1e-15 * norm(n) {
+        if !(dot(x, n) > 0.0) {
             return None;
         }
         q = q.min(quality(x, a, b));

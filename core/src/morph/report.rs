@@ -7,9 +7,12 @@ use crate::mesh::Point3;
 use crate::register::surface::SurfaceIndex;
 
 /// One-sided max distance from points (vertices and face centroids of A) to surface B.
-fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &SurfaceIndex) -> f64 {
+fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &SurfaceIndex, centroids: bool) -> f64 {
     use rayon::prelude::*;
     let v = pa.par_iter().filter_map(|&p| b.closest(p)).map(|h| h.dist2).reduce(|| 0.0, f64::max);
+    if !centroids {
+        return v.sqrt();
+    }
     let c = ta
         .par_iter()
         .map(|t| {
@@ -24,10 +27,18 @@ fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &SurfaceIndex) -> f64 {
 
 /// Symmetric Hausdorff distance (sampled at vertices and face centroids) between two triangle
 /// surfaces, divided by the bounding-box diagonal of the second (the reference input).
-pub fn relative_hausdorff(pa: &[Point3], ta: &[[u32; 3]], pb: &[Point3], tb: &[[u32; 3]]) -> f64 {
+/// `a_centroids`: also sample A's face centroids (not needed when every face of A is known to lie
+/// inside one face of B, as for the overlay metamesh: then A's vertices bound the distance).
+pub fn relative_hausdorff(
+    pa: &[Point3],
+    ta: &[[u32; 3]],
+    pb: &[Point3],
+    tb: &[[u32; 3]],
+    a_centroids: bool,
+) -> f64 {
     let ia = SurfaceIndex::new(pa, ta);
     let ib = SurfaceIndex::new(pb, tb);
-    let d = one_sided(pa, ta, &ib).max(one_sided(pb, tb, &ia));
+    let d = one_sided(pa, ta, &ib, a_centroids).max(one_sided(pb, tb, &ia, true));
     let diag = Aabb::of(pb).map(|b| b.diagonal()).unwrap_or(1.0).max(1e-300);
     d / diag
 }

@@ -61,6 +61,17 @@ fn plane_quadric(a: Point3, b: Point3, c: Point3) -> [f64; 10] {
     q
 }
 
+/// 4√3·area / Σ edge²: 1 for an equilateral triangle, 0 for a degenerate one.
+fn shape(q: [Point3; 3]) -> f64 {
+    let l2 = dot(sub(q[1], q[0]), sub(q[1], q[0]))
+        + dot(sub(q[2], q[1]), sub(q[2], q[1]))
+        + dot(sub(q[0], q[2]), sub(q[0], q[2]));
+    if l2 <= 0.0 {
+        return 0.0;
+    }
+    2.0 * 3f64.sqrt() * norm(cross(sub(q[1], q[0]), sub(q[2], q[0]))) / l2
+}
+
 fn quadric_eval(q: &[f64; 10], v: Point3) -> f64 {
     let x = [v[0], v[1], v[2], 1.0];
     let mut s = 0.0;
@@ -151,6 +162,7 @@ impl Hierarchy {
             return false;
         }
         if strict {
+            // Keep valences moderate: high valences make thin spherical triangles.
             if ns.len() + nt.len() - 4 > 14 {
                 return false;
             }
@@ -168,11 +180,8 @@ impl Hierarchy {
                 if na <= 1e-12 * nb.max(1e-300) || dot(before, after) < 0.3 * nb * na {
                     return false;
                 }
-                // Refuse slivers: the new face's shape quality must stay reasonable.
-                let l2 = dot(sub(q[1], q[0]), sub(q[1], q[0]))
-                    + dot(sub(q[2], q[1]), sub(q[2], q[1]))
-                    + dot(sub(q[0], q[2]), sub(q[0], q[2]));
-                if 2.0 * 3f64.sqrt() * na / l2 < 0.05 {
+                // Refuse new slivers (but accept faces no worse than a sliver already there).
+                if shape(q) < 0.05f64.min(0.5 * shape(p)) {
                     return false;
                 }
             }
@@ -285,18 +294,12 @@ impl Hierarchy {
                 continue;
             }
             self.collapse(vt, vs);
+            // Only the edges at vs changed cost (its quadric grew); entries for other edges stay
+            // valid and are re-checked for collapsibility when popped.
             stamp[vs as usize] += 1;
-            // Costs change for every edge at vs (its quadric grew); neighbours' stamps change too
-            // so their stale entries with vs are discarded.
             for w in self.neighbours(vs) {
-                stamp[w as usize] += 1;
-            }
-            let nbrs = self.neighbours(vs);
-            for &w in &nbrs {
-                for x in self.neighbours(w) {
-                    heap.push(Reverse((Cost(self.cost(w, x)), w, x, stamp[w as usize], stamp[x as usize])));
-                    heap.push(Reverse((Cost(self.cost(x, w)), x, w, stamp[x as usize], stamp[w as usize])));
-                }
+                heap.push(Reverse((Cost(self.cost(w, vs)), w, vs, stamp[w as usize], stamp[vs as usize])));
+                heap.push(Reverse((Cost(self.cost(vs, w)), vs, w, stamp[vs as usize], stamp[w as usize])));
             }
         }
         if !strict && self.alive_vertices > target {
