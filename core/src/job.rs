@@ -214,13 +214,19 @@ impl JobKind {
     }
 }
 
-/// Deserialises `params` for a job, naming the offending field on error.
+/// Deserialises `params` for a job, naming the offending field on error (its JSON path, e.g.
+/// `method` for a bad enum value, `weights[3]` inside a list; unknown fields by their name).
 pub fn parse_params<P: serde::de::DeserializeOwned>(params: serde_json::Value) -> Result<P> {
     let params = if params.is_null() { serde_json::Value::Object(Default::default()) } else { params };
-    serde_json::from_value(params).map_err(|e| {
-        let msg = e.to_string();
-        // serde's messages name the field ("unknown field `foo`", "invalid type … for `bar`").
-        let field = msg.split('`').nth(1).unwrap_or("params").to_string();
+    serde_path_to_error::deserialize(params).map_err(|e| {
+        let path = e.path().to_string();
+        let msg = e.into_inner().to_string();
+        let field = if path.is_empty() || path == "." {
+            // serde's messages name the field ("unknown field `foo`", "missing field `bar`").
+            msg.split('`').nth(1).unwrap_or("params").to_string()
+        } else {
+            path
+        };
         Error::params(field, msg)
     })
 }
@@ -285,6 +291,28 @@ mod tests {
         let e = parse_params::<EmptyParams>(serde_json::json!({"bogus": 1})).unwrap_err();
         match e {
             Error::InvalidParams { field, .. } => assert_eq!(field, "bogus"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_value_names_its_field_not_the_value() {
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        enum Method {
+            #[serde(rename = "taubin")]
+            Taubin,
+        }
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct P {
+            method: Method,
+        }
+        match parse_params::<P>(serde_json::json!({"method": "nope"})).unwrap_err() {
+            Error::InvalidParams { field, message } => {
+                assert_eq!(field, "method");
+                assert!(message.contains("nope"), "{message}");
+            }
             other => panic!("{other:?}"),
         }
     }

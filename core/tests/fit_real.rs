@@ -7,8 +7,8 @@ use std::collections::HashMap;
 
 use meshwork_core::fit::kdtree::KdTree;
 use meshwork_core::fit::smooth::closest_on_triangle;
-use meshwork_core::fit::testdata::{bend, plane_sections, thin_network};
-use meshwork_core::fit::{run, FitPair, FitParams};
+use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
+use meshwork_core::fit::{run, FitParams};
 use meshwork_core::geometry::{dist, dot, triangle_cross, Aabb};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::{Mesh, Point3};
@@ -90,28 +90,9 @@ fn homer_fits_sections_of_its_bent_self() {
     // section point kept; the template is homer split once (same surface, 4× the faces).
     let mut curves = thin_network(&plane_sections(&original, &planes), 2);
     let template = subdivide_midpoint(&original, 1);
-    // The user's pairs, as a user would pick them: where sections cross (degree-4 curve points),
-    // the template vertex nearest to the crossing ↔ the crossing on the bent target.
-    let mut degree: HashMap<u32, usize> = HashMap::new();
-    for c in &curves.curves {
-        for &v in c {
-            *degree.entry(v).or_default() += 1;
-        }
-    }
-    let mut crossings: Vec<u32> = degree.iter().filter(|(_, &d)| d >= 4).map(|(&v, _)| v).collect();
-    crossings.sort();
-    let step = (crossings.len() / 12).max(1);
-    let pairs: Vec<FitPair> = crossings
-        .iter()
-        .step_by(step)
-        .map(|&c| {
-            let p = curves.positions[c as usize];
-            let v = (0..template.positions.len())
-                .min_by(|&a, &b| dist(template.positions[a], p).total_cmp(&dist(template.positions[b], p)))
-                .unwrap();
-            FitPair { template_vertex: v as u32, curve_point: bend(p, 1.0) }
-        })
-        .collect();
+    // The user's pairs, as a user would pick them: where sections cross, the template vertex
+    // nearest to the crossing ↔ the crossing on the bent target.
+    let pairs = crossing_pairs(&curves, &template, 12, |p| bend(p, 1.0));
     for p in curves.positions.iter_mut() {
         *p = bend(*p, 1.0);
     }

@@ -125,7 +125,7 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
         }
         if out == Path::new("-") {
             mesh_to_stdout = true;
-            std::io::stdout().write_all(&bytes).map_err(|e| Failure::io(format!("error[io]: stdout: {e}")))?;
+            write_stdout(&bytes)?;
         } else {
             std::fs::write(out, &bytes)
                 .map_err(|e| Failure::io(format!("error[io]: cannot write {}: {e}", out.display())))?;
@@ -138,9 +138,19 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
         Some(r) if r != Path::new("-") => std::fs::write(r, report + "\n")
             .map_err(|e| Failure::io(format!("error[io]: cannot write {}: {e}", r.display())))?,
         _ if mesh_to_stdout => {}
-        _ => println!("{report}"),
+        _ => write_stdout(format!("{report}\n").as_bytes())?,
     }
     Ok(())
+}
+
+/// Writes to stdout; a closed pipe (`meshwork info x | head`) is not an error worth reporting.
+fn write_stdout(bytes: &[u8]) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|_| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure::io(format!("error[io]: stdout: {e}"))),
+    }
 }
 
 fn read_params_file(path: &Path) -> Result<Map<String, Value>, Failure> {

@@ -115,3 +115,36 @@ fn help_lists_every_command() {
         assert!(t.contains(c), "{c} missing from --help");
     }
 }
+
+#[test]
+fn info_repair_and_smooth_on_shared_meshes() {
+    let cow = shared_mesh("cow.obj");
+    let o = run(&["info", cow.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // shared/meshes/README.md: 2,903 vertices, 5,804 triangles, closed.
+    assert_eq!((v["vertices"].as_u64(), v["faces"].as_u64(), v["closed"].as_bool()), (Some(2903), Some(5804), Some(true)));
+
+    let out = tmp("suzanne-repaired.glb");
+    let rep = tmp("suzanne-report.json");
+    let o = run(&["repair", shared_mesh("suzanne.obj").to_str().unwrap(), "-o", out.to_str().unwrap(), "--report", rep.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(o.stdout.is_empty(), "report went to the file, not stdout");
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&rep).unwrap()).unwrap();
+    assert!(r["total_ms"].is_number());
+    let m = read(&std::fs::read(&out).unwrap(), &ReadOptions::default()).unwrap().mesh;
+    assert!(m.face_count() > 0);
+
+    // Flags are the params' names: --method, --iterations, --preserve-volume (alone = true).
+    let out = tmp("fandisk-smooth.obj");
+    let o = run(&["smooth", shared_mesh("fandisk.obj").to_str().unwrap(), "-o", out.to_str().unwrap(),
+        "--method", "taubin", "--iterations", "3", "--preserve-volume"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(r["volume_change"].is_number() && r["hausdorff"].is_number(), "{r}");
+    let m = read(&std::fs::read(&out).unwrap(), &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(m.vertex_count(), 6475);
+    let o = run(&["smooth", shared_mesh("fandisk.obj").to_str().unwrap(), "-o", out.to_str().unwrap(), "--method", "nope"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("method"), "{}", stderr(&o));
+}

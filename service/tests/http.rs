@@ -297,3 +297,73 @@ fn sigterm_finishes_running_job_then_exits() {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+#[test]
+fn every_format_out_and_back_in() {
+    let s = Server::start(&[]);
+    let woody = mesh_bytes("woody.obj");
+    for (fmt, mime) in [("glb", "model/gltf-binary"), ("gltf", "model/gltf+json"), ("obj", "model/obj"),
+        ("ply", "application/x-ply"), ("stl", "model/stl"), ("off", "application/x-off")]
+    {
+        let r = s.post(&format!("/v1/convert?format={fmt}"), "model/obj", &woody);
+        assert_eq!(r.status, 200, "{fmt}: {}", r.text());
+        assert_eq!(r.header("content-type"), Some(mime));
+        if fmt == "glb" {
+            assert_eq!(&r.body[..4], b"glTF");
+        }
+        // And back in as a raw body with its media type; woody: 694 vertices, 1267 triangles.
+        let back = s.post("/v1/convert?format=obj", mime, &r.body);
+        assert_eq!(back.status, 200, "{fmt} back in: {}", back.text());
+        let m = read_obj(&back.body);
+        assert_eq!(m.face_count(), 1267, "{fmt}");
+        if fmt != "stl" {
+            // STL stores unshared triangle corners, so only faces survive it as counted.
+            assert_eq!(m.vertex_count(), 694, "{fmt}");
+        }
+    }
+    // GLB is the default output.
+    let r = s.post("/v1/convert", "model/obj", &woody);
+    assert_eq!(r.header("content-type"), Some("model/gltf-binary"));
+}
+
+#[test]
+fn validate_repair_and_smooth_through_http() {
+    let s = Server::start(&[]);
+    // Validate answers with the report itself. Bunny: one component, 5 holes in the base.
+    let r = s.post_multipart("/v1/validate", &[file_part("mesh", "bunny.obj", &mesh_bytes("stanford-bunny.obj"))]);
+    assert_eq!(r.status, 200, "{}", r.text());
+    assert_eq!(r.header("content-type"), Some("application/json"));
+    let v = r.json();
+    assert_eq!((v["faces"].as_u64(), v["boundary_loops"].as_u64(), v["components"].as_u64()), (Some(69451), Some(5), Some(1)), "{v}");
+    // cow.obj: closed.
+    let v = s.post("/v1/validate", "model/obj", &mesh_bytes("cow.obj")).json();
+    assert_eq!((v["vertices"].as_u64(), v["closed"].as_bool()), (Some(2903), Some(true)), "{v}");
+
+    // Repair with params from a JSON part.
+    let r = s.post_multipart(
+        "/v1/repair?format=obj&report=inline",
+        &[file_part("mesh", "suzanne.obj", &mesh_bytes("suzanne.obj")), json_part("params", "{}")],
+    );
+    assert_eq!(r.status, 200, "{}", r.text());
+    let parts = split_mixed(r.header("content-type").unwrap(), &r.body);
+    let report: serde_json::Value = serde_json::from_slice(&parts[0].1).unwrap();
+    assert!(report["total_ms"].is_number(), "{report}");
+    assert!(read_obj(&parts[1].1).face_count() > 0);
+
+    // Smooth with params in the query, GLB out; the report is behind the Link header.
+    let fandisk = mesh_bytes("fandisk.obj");
+    let r = s.post("/v1/smooth?method=taubin&iterations=5", "model/obj", &fandisk);
+    assert_eq!(r.status, 200, "{}", r.text());
+    let out = read(&r.body, &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(out.vertex_count(), 6475, "fandisk keeps its vertices");
+    let link = r.header("link").unwrap();
+    let url = link.trim_start_matches('<').split('>').next().unwrap();
+    let rep = s.get(url).json();
+    for k in ["volume_change", "area_change", "hausdorff", "total_ms"] {
+        assert!(rep[k].is_number(), "{k} missing: {rep}");
+    }
+    assert!(rep["hausdorff"].as_f64().unwrap() > 0.0, "smoothing moved nothing");
+    // A bad smoothing parameter is named.
+    let p = s.post("/v1/smooth?method=bogus", "model/obj", &fandisk).problem(422, "invalid-params");
+    assert_eq!(p["field"], "method", "{p}");
+}

@@ -61,6 +61,33 @@ pub fn detect(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> FlipSca
     scan
 }
 
+/// The flagged faces plus every face around a matched vertex (`matched`: template vertex of each
+/// curve point) that belongs to a flagged face.
+pub fn with_matched_stars(tris: &[[u32; 3]], flagged: &[u32], matched: &[u32]) -> Vec<u32> {
+    let nv = tris.iter().flat_map(|t| t.iter()).map(|&v| v as usize + 1).max().unwrap_or(0);
+    let mut is_matched = vec![false; nv.max(matched.iter().map(|&v| v as usize + 1).max().unwrap_or(0))];
+    for &v in matched {
+        is_matched[v as usize] = true;
+    }
+    let mut culprit = vec![false; is_matched.len()];
+    for &f in flagged {
+        for &v in &tris[f as usize] {
+            if is_matched[v as usize] {
+                culprit[v as usize] = true;
+            }
+        }
+    }
+    let mut out: Vec<u32> = flagged.to_vec();
+    for (f, t) in tris.iter().enumerate() {
+        if t.iter().any(|&v| culprit[v as usize]) {
+            out.push(f as u32);
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// Splits every edge of the `flagged` faces at its midpoint and re-triangulates each touched face
 /// conformingly (1→2, 1→3 or 1→4, red-green style), so no T-junctions appear. Returns how many
 /// faces were added.

@@ -533,8 +533,10 @@ fn fine_fit(
                 augmented,
             },
         };
-        // Keep the round with the fewest flips; subdivision that does not reduce them stops the
-        // loop (it would only grow the mesh where the field itself is too steep).
+        // Keep the round with the fewest flips; a round that does not improve stops the loop
+        // (measured on homer: 52 → 23 → 37 → 98 → 375 flagged faces when it goes on, because the
+        // new, smaller faces fold in the same steep part of the field).
+        let matched_now = fine.vertex_of_point.clone();
         let improves = best.as_ref().is_none_or(|b| fine.report.flipped_faces < b.0.report.flipped_faces);
         if improves {
             best = Some((fine, pos.clone(), tris.clone()));
@@ -546,7 +548,11 @@ fn fine_fit(
         if done {
             break;
         }
-        faces_added += flips::subdivide(pos, tris, &flagged);
+        // Subdivide the flagged faces and the stars of the matched vertices on them: a fold
+        // usually comes from a curve vertex matched to a template vertex a whole edge away, and
+        // the star's new edge midpoints give it a closer candidate in the next round.
+        let split = flips::with_matched_stars(tris, &flagged, &matched_now);
+        faces_added += flips::subdivide(pos, tris, &split);
     }
     if let Some((mut fine, p, t)) = best {
         *pos = p;

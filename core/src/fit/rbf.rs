@@ -194,27 +194,46 @@ impl Rbf {
     /// The field's value at `p`.
     pub fn eval(&self, p: Point3) -> Point3 {
         let q = [(p[0] - self.origin[0]) / self.scale, (p[1] - self.origin[1]) / self.scale, (p[2] - self.origin[2]) / self.scale];
-        let (mut sx, mut sy, mut sz) = (0.0, 0.0, 0.0);
-        // Plain indexed loop over struct-of-arrays: the compiler vectorises it (sqrt included).
-        for j in 0..self.cx.len() {
-            let dx = q[0] - self.cx[j];
-            let dy = q[1] - self.cy[j];
-            let dz = q[2] - self.cz[j];
-            let r = (dx * dx + dy * dy + dz * dz).sqrt();
-            let f = match self.kernel {
-                Kernel::Linear => r,
-                Kernel::Cubic => r * r * r,
-            };
-            sx += f * self.w[0][j];
-            sy += f * self.w[1][j];
-            sz += f * self.w[2][j];
-        }
+        let (sx, sy, sz) = match self.kernel {
+            Kernel::Linear => self.radial_sum(q, |r| r),
+            Kernel::Cubic => self.radial_sum(q, |r| r * r * r),
+        };
         let a = &self.affine;
         [
             sx + a[0][0] * q[0] + a[1][0] * q[1] + a[2][0] * q[2] + a[3][0],
             sy + a[0][1] * q[0] + a[1][1] * q[1] + a[2][1] * q[2] + a[3][1],
             sz + a[0][2] * q[0] + a[1][2] * q[1] + a[2][2] * q[2] + a[3][2],
         ]
+    }
+
+    /// Σ_j φ(|q − c_j|) α_j. Equal-length slices and a kernel fixed per call let the compiler
+    /// vectorise the loop (sqrt included); 4 partial sums break the add dependency chain.
+    #[inline(always)]
+    fn radial_sum(&self, q: Point3, phi: impl Fn(f64) -> f64) -> (f64, f64, f64) {
+        let n = self.cx.len();
+        let (cx, cy, cz) = (&self.cx[..n], &self.cy[..n], &self.cz[..n]);
+        let (wx, wy, wz) = (&self.w[0][..n], &self.w[1][..n], &self.w[2][..n]);
+        let mut acc = [[0.0f64; 4]; 3];
+        let chunks = n / 4;
+        for c in 0..chunks {
+            for l in 0..4 {
+                let j = c * 4 + l;
+                let (dx, dy, dz) = (q[0] - cx[j], q[1] - cy[j], q[2] - cz[j]);
+                let f = phi((dx * dx + dy * dy + dz * dz).sqrt());
+                acc[0][l] += f * wx[j];
+                acc[1][l] += f * wy[j];
+                acc[2][l] += f * wz[j];
+            }
+        }
+        for j in chunks * 4..n {
+            let (dx, dy, dz) = (q[0] - cx[j], q[1] - cy[j], q[2] - cz[j]);
+            let f = phi((dx * dx + dy * dy + dz * dz).sqrt());
+            acc[0][0] += f * wx[j];
+            acc[1][0] += f * wy[j];
+            acc[2][0] += f * wz[j];
+        }
+        let s = |a: [f64; 4]| (a[0] + a[1]) + (a[2] + a[3]);
+        (s(acc[0]), s(acc[1]), s(acc[2]))
     }
 
     /// The field at many points (rayon over chunks; polls `progress` between chunks).

@@ -2,7 +2,7 @@
 
 use serde::Serialize;
 
-use crate::geometry::{add, corner_angle, dist, dot, normalize, scale, triangle_cross};
+use crate::geometry::{add, corner_angle, dist, dot, norm2, normalize, scale, sub, triangle_cross};
 use crate::mesh::{Mesh, Point3};
 
 use super::curves::CurveNetwork;
@@ -23,7 +23,16 @@ pub fn angle_stats(pos: &[Point3], tris: &[[u32; 3]]) -> AngleStats {
     let (mut min, mut sum, mut below) = (180.0f64, 0.0, 0);
     for t in tris {
         let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-        let m = corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b)).to_degrees();
+        // The smallest angle is opposite the shortest edge: one atan2 per triangle.
+        let (la, lb, lc) = (norm2(sub(b, c)), norm2(sub(c, a)), norm2(sub(a, b)));
+        let m = if la <= lb && la <= lc {
+            corner_angle(a, b, c)
+        } else if lb <= lc {
+            corner_angle(b, c, a)
+        } else {
+            corner_angle(c, a, b)
+        }
+        .to_degrees();
         min = min.min(m);
         sum += m;
         below += (m < 10.0) as usize;

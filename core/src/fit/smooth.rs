@@ -25,6 +25,8 @@ pub struct SmoothSettings {
 
 /// Compressed vertex → neighbours and vertex → faces.
 struct Rings {
+    /// Face across edge k (t[k], t[k+1]) of each face, u32::MAX on the boundary.
+    ff: Vec<[u32; 3]>,
     nb_off: Vec<u32>,
     nb: Vec<u32>,
     vf_off: Vec<u32>,
@@ -62,7 +64,18 @@ fn rings(nv: usize, tris: &[[u32; 3]]) -> Rings {
         }
         nb_off[v + 1] = nb.len() as u32;
     }
-    Rings { nb_off, nb, vf_off: vf_cnt, vf }
+    let mut half: super::trimesh::IntMap<(u32, u32), u32> = super::trimesh::IntMap::default();
+    half.reserve(tris.len() * 3);
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            half.insert((t[k], t[(k + 1) % 3]), f as u32);
+        }
+    }
+    let ff = tris
+        .iter()
+        .map(|t| std::array::from_fn(|k| *half.get(&(t[(k + 1) % 3], t[k])).unwrap_or(&u32::MAX)))
+        .collect();
+    Rings { ff, nb_off, nb, vf_off: vf_cnt, vf }
 }
 
 fn face_normal(pos: &[Point3], t: [u32; 3]) -> Point3 {
@@ -159,32 +172,35 @@ fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
     scale(add(add(pos[t[0] as usize], pos[t[1] as usize]), pos[t[2] as usize]), 1.0 / 3.0)
 }
 
-/// Closest point on the reference surface near face `start`: greedy walk over faces sharing a
-/// vertex with the current best until no neighbour is closer (bounded steps).
+/// Closest point on the reference surface near face `start`: walk across the edge opposite the
+/// most negative barycentric coordinate of `p`'s projection until it falls inside a face (one
+/// triangle test per step; usually 0–2 steps since vertices move little per iteration).
 fn closest_by_walk(pos: &[Point3], tris: &[[u32; 3]], r: &Rings, start: u32, p: Point3) -> (u32, Point3) {
-    let mut best_f = start;
-    let mut best_q = closest_on_triangle(p, tris[start as usize], pos);
-    let mut best_d = norm2(sub(best_q, p));
-    for _ in 0..16 {
-        let mut improved = false;
-        let t = tris[best_f as usize];
-        for &v in &t {
-            for &g in &r.vf[r.vf_off[v as usize] as usize..r.vf_off[v as usize + 1] as usize] {
-                if g == best_f {
-                    continue;
-                }
-                let q = closest_on_triangle(p, tris[g as usize], pos);
-                let d = norm2(sub(q, p));
-                if d < best_d * (1.0 - 1e-12) {
-                    (best_f, best_q, best_d, improved) = (g, q, d, true);
-                }
-            }
-        }
-        if !improved {
+    let mut f = start;
+    for _ in 0..12 {
+        let t = tris[f as usize];
+        let a = pos[t[0] as usize];
+        let (v0, v1, v2) = (sub(pos[t[1] as usize], a), sub(pos[t[2] as usize], a), sub(p, a));
+        let (d00, d01, d11, d20, d21) = (dot(v0, v0), dot(v0, v1), dot(v1, v1), dot(v2, v0), dot(v2, v1));
+        let den = d00 * d11 - d01 * d01;
+        if den <= 0.0 {
             break;
         }
+        let v = (d11 * d20 - d01 * d21) / den;
+        let w = (d00 * d21 - d01 * d20) / den;
+        let u = 1.0 - v - w;
+        // Edge k of a face is (t[k], t[k+1]); the edge opposite corner 0 is 1, and so on.
+        let (m, edge) = if u <= v && u <= w { (u, 1) } else if v <= w { (v, 2) } else { (w, 0) };
+        if m >= -1e-12 {
+            return (f, add(a, add(scale(v0, v), scale(v1, w))));
+        }
+        let next = r.ff[f as usize][edge];
+        if next == u32::MAX {
+            break;
+        }
+        f = next;
     }
-    (best_f, best_q)
+    (f, closest_on_triangle(p, tris[f as usize], pos))
 }
 
 /// Closest point on triangle `t` to `p` (Ericson, Real-Time Collision Detection §5.1.5).

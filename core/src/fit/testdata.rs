@@ -175,3 +175,34 @@ pub fn thin_network(curves: &Mesh, k: usize) -> Mesh {
     }
     Mesh { positions: curves.positions.clone(), curves: lines, ..Default::default() }
 }
+
+/// Pairs as a user would pick them on a section network: at up to `count` crossing points
+/// (curve vertices used by ≥ 4 two-point lines, i.e. where sections meet), the template vertex
+/// nearest to the crossing on the *undeformed* surface ↔ the crossing moved by `map`.
+pub fn crossing_pairs(
+    curves: &Mesh,
+    template: &Mesh,
+    count: usize,
+    map: impl Fn(Point3) -> Point3,
+) -> Vec<super::FitPair> {
+    let mut degree: HashMap<u32, usize> = HashMap::new();
+    for c in &curves.curves {
+        for &v in c {
+            *degree.entry(v).or_default() += 1;
+        }
+    }
+    let mut crossings: Vec<u32> = degree.iter().filter(|(_, &d)| d >= 4).map(|(&v, _)| v).collect();
+    crossings.sort();
+    let step = (crossings.len() / count.max(1)).max(1);
+    let tree = super::kdtree::KdTree::new(&template.positions);
+    crossings
+        .iter()
+        .step_by(step)
+        .take(count)
+        .filter_map(|&c| {
+            let p = curves.positions[c as usize];
+            let (v, _) = tree.nearest(p)?;
+            Some(super::FitPair { template_vertex: v, curve_point: map(p) })
+        })
+        .collect()
+}

@@ -144,6 +144,13 @@ pub fn fill(mesh: &mut Mesh, opts: &FillOptions, progress: &Progress) -> Result<
         let exists = |a: u32, b: u32| -> bool {
             topo.find_edge(a, b).is_some() || created.contains(&(a.min(b), a.max(b)))
         };
+        // Any surface spanning the loop has at least the loop's vector area (its largest
+        // projected area), so a loop whose vector area already exceeds the limit is skipped
+        // before the O(n³) DP.
+        if vector_area(&patch.pos) > opts.max_hole_area_ratio * comp_area[comp] {
+            skip(&mut r, "patch larger than max_hole_area_ratio of its component");
+            continue;
+        }
         let used_dp = n <= opts.dp_max_edges;
         let tris = if used_dp { liepa_dp(&patch.pos, &w, &nb, &exists, progress)? } else { None };
         let by_dp = tris.is_some();
@@ -194,6 +201,15 @@ pub fn fill(mesh: &mut Mesh, opts: &FillOptions, progress: &Progress) -> Result<
     }
     r.filled_edges.sort_unstable_by(|a, b| b.cmp(a));
     Ok(r)
+}
+
+/// |½ Σ pᵢ × pᵢ₊₁| of a closed polygon: a lower bound on the area of any surface it bounds.
+fn vector_area(p: &[Point3]) -> f64 {
+    let mut s = [0.0; 3];
+    for i in 0..p.len() {
+        s = add(s, cross(p[i], p[(i + 1) % p.len()]));
+    }
+    0.5 * norm(s)
 }
 
 /// Mean length of the edges at each vertex (Liepa's σ), 0 for isolated vertices.
@@ -534,6 +550,17 @@ mod tests {
         assert!(r.filled_edges.contains(&8));
         // Planar: every patch triangle is flat, inner patch area exactly 4, outer 16.
         assert!((r.area_added - 20.0).abs() < 1e-9, "{}", r.area_added);
+    }
+
+    #[test]
+    fn vector_area_of_unit_square_in_any_position() {
+        let sq = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 1.0], [0.0, 1.0, 1.0]];
+        assert!((vector_area(&sq) - 1.0).abs() < 1e-12);
+        // Non-planar: (½, −½, 1) by hand = √1.5, below the area of either two-triangle filling
+        // (0.5 + √3/2 along the 0–2 diagonal).
+        let folded = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 1.0]];
+        assert!((vector_area(&folded) - 1.5f64.sqrt()).abs() < 1e-12);
+        assert!(vector_area(&folded) < 0.5 + 3f64.sqrt() / 2.0);
     }
 
     #[test]

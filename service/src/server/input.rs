@@ -75,7 +75,9 @@ pub async fn parse_body(req: Request, q: &QueryOpts, limits: &Limits) -> Result<
     let limit = limits.max_body_bytes;
     if let Some(len) = content_length(req.headers()) {
         if len > limit {
-            return Err(body_too_large(limit, len));
+            let mut p = body_too_large(limit, len);
+            p.close = !drain(req.into_body()).await;
+            return Err(p);
         }
     }
     let ctype = req
@@ -89,7 +91,11 @@ pub async fn parse_body(req: Request, q: &QueryOpts, limits: &Limits) -> Result<
     } else {
         let body = axum::body::to_bytes(req.into_body(), limit.min(usize::MAX as u64) as usize)
             .await
-            .map_err(|e| too_large_or_bad(e, limit))?;
+            .map_err(|e| {
+                let mut p = too_large_or_bad(e, limit);
+                p.close = true;
+                p
+            })?;
         if body.is_empty() {
             return Err(Problem::bad_request(
                 "no mesh in the request: send the file as the body (with Content-Type) or as multipart `mesh` parts",
@@ -111,6 +117,29 @@ pub async fn parse_body(req: Request, q: &QueryOpts, limits: &Limits) -> Result<
         parsed.job = Some(j.clone());
     }
     Ok(parsed)
+}
+
+/// Reads and drops up to 4 MiB of a body we refuse, for at most 2 s; true when it reached the end.
+pub async fn drain(body: axum::body::Body) -> bool {
+    use http_body_util::BodyExt;
+    const CAP: usize = 4 << 20;
+    let mut body = body;
+    let mut seen = 0usize;
+    let work = async {
+        while let Some(frame) = body.frame().await {
+            match frame {
+                Ok(f) => {
+                    seen += f.data_ref().map_or(0, |d| d.len());
+                    if seen > CAP {
+                        return false;
+                    }
+                }
+                Err(_) => return false,
+            }
+        }
+        true
+    };
+    tokio::time::timeout(std::time::Duration::from_secs(2), work).await.unwrap_or(false)
 }
 
 fn content_length(h: &HeaderMap) -> Option<u64> {
@@ -150,7 +179,11 @@ async fn parse_multipart(req: Request, limit: u64) -> Result<Parsed, Problem> {
         let field = match mp.next_field().await {
             Ok(Some(f)) => f,
             Ok(None) => break,
-            Err(e) => return Err(multipart_error(e, limit)),
+            Err(e) => {
+                let mut p = multipart_error(e, limit);
+                p.close = true;
+                return Err(p);
+            }
         };
         let name = field.name().unwrap_or("").to_string();
         let file_name = field.file_name().map(str::to_string);

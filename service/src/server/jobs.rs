@@ -152,15 +152,21 @@ fn job_headers(h: &mut HeaderMap, id: &str) {
 pub async fn submit_sync(State(st): State<Shared>, Path(job): Path<String>, req: Request) -> Response {
     match sync_inner(st, job, req).await {
         Ok(r) => r,
-        Err(p) => refused(p),
+        Err(p) => p.into_response(),
     }
 }
 
 async fn sync_inner(st: Shared, job: String, req: Request) -> Result<Response, Problem> {
-    let kind = kind_of(&st, &job)?;
-    let q = input::parse_query(req.uri().query())?;
-    let format = input::choose_format(q.format.as_deref(), req.headers())?;
-    let permit = admit(&st)?;
+    let pre = (|| {
+        let kind = kind_of(&st, &job)?;
+        let q = input::parse_query(req.uri().query())?;
+        let format = input::choose_format(q.format.as_deref(), req.headers())?;
+        Ok::<_, Problem>((kind, q, format, admit(&st)?))
+    })();
+    let (kind, q, format, permit) = match pre {
+        Ok(x) => x,
+        Err(p) => return Ok(refused_early(p, req).await),
+    };
     let parsed = input::parse_body(req, &q, &st.cfg.limits).await?;
     let (id, progress, rx) = launch(&st, kind, parsed, format, false, permit);
     let mut guard = CancelOnDrop(Some(progress));
@@ -180,15 +186,13 @@ async fn sync_inner(st: Shared, job: String, req: Request) -> Result<Response, P
     Ok(resp)
 }
 
-/// An error response to a submission. One refused before its job started (no `job_id`) may leave
-/// the request body unread, so the connection is closed rather than reused mid-body.
-fn refused(p: Problem) -> Response {
-    let early = !p.extra.contains_key("job_id");
-    let mut r = p.into_response();
-    if early {
-        r.headers_mut().insert(header::CONNECTION, HeaderValue::from_static("close"));
-    }
-    r
+/// An error response to a submission refused before its body was read: read (and drop) a bounded
+/// amount of the body first, so that closing the socket does not reset the connection under the
+/// client before it has read the answer; close the connection when the body was too big to drain.
+async fn refused_early(p: Problem, req: Request) -> Response {
+    let mut p = p;
+    p.close = !input::drain(req.into_body()).await;
+    p.into_response()
 }
 
 fn file_response(f: ResultFile, name: &str) -> Response {
@@ -228,18 +232,24 @@ fn multipart_mixed(report: &Value, f: &ResultFile, name: &str) -> Response {
 pub async fn submit_async(State(st): State<Shared>, req: Request) -> Response {
     match async_inner(st, req).await {
         Ok(r) => r,
-        Err(p) => refused(p),
+        Err(p) => p.into_response(),
     }
 }
 
 async fn async_inner(st: Shared, req: Request) -> Result<Response, Problem> {
-    let q: QueryOpts = input::parse_query(req.uri().query())?;
-    // A job named in the query is checked before the upload is read.
-    if let Some(j) = &q.job {
-        kind_of(&st, j)?;
-    }
-    let format = input::choose_format(q.format.as_deref(), req.headers())?;
-    let permit = admit(&st)?;
+    let pre = (|| {
+        let q: QueryOpts = input::parse_query(req.uri().query())?;
+        // A job named in the query is checked before the upload is read.
+        if let Some(j) = &q.job {
+            kind_of(&st, j)?;
+        }
+        let format = input::choose_format(q.format.as_deref(), req.headers())?;
+        Ok::<_, Problem>((q, format, admit(&st)?))
+    })();
+    let (q, format, permit) = match pre {
+        Ok(x) => x,
+        Err(p) => return Ok(refused_early(p, req).await),
+    };
     let parsed = input::parse_body(req, &q, &st.cfg.limits).await?;
     let job = parsed.job.clone().ok_or_else(|| {
         Problem::new("invalid-params", "name the job: `?job=smooth`, a `job` part, or `\"job\"` in params")

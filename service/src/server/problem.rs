@@ -27,6 +27,9 @@ pub struct Problem {
     pub extra: Map<String, Value>,
     #[serde(skip)]
     pub retry_after: Option<u64>,
+    /// Close the connection after answering (the request body was not read to its end).
+    #[serde(skip)]
+    pub close: bool,
 }
 
 /// Every problem kind: (slug, HTTP status, title). The OpenAPI document and `/problems/{kind}`
@@ -71,6 +74,7 @@ impl Problem {
             detail: detail.into(),
             extra,
             retry_after: None,
+            close: false,
         }
     }
 
@@ -136,12 +140,15 @@ impl Problem {
 impl IntoResponse for Problem {
     fn into_response(self) -> Response {
         let status = self.status();
-        let retry = self.retry_after;
+        let (retry, close) = (self.retry_after, self.close);
         let body = serde_json::to_vec(&self).unwrap_or_else(|_| b"{}".to_vec());
         let mut r = (status, body).into_response();
         r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(MEDIA_TYPE));
         if let Some(s) = retry {
             r.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from(s));
+        }
+        if close {
+            r.headers_mut().insert(header::CONNECTION, HeaderValue::from_static("close"));
         }
         r
     }

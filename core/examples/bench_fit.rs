@@ -1,0 +1,182 @@
+//! Fit benchmark: a real template (homer.obj split 0–2 times: 6k, 24k, 96k vertices) fitted to
+//! plane sections of a known bend of itself, with 12 user pairs. Prints the stage timings and
+//! quality of each run, the growth with template size and with curve-vertex count, and a
+//! same-run peer comparison of the RBF stage against SciPy's `RBFInterpolator` (same kernel φ = r,
+//! degree-1 polynomial), when the peers venv is installed.
+//!
+//! Run: `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example bench_fit`
+//! (from the repository root; reads `../shared/meshes/homer.obj`).
+
+use std::time::Instant;
+
+use meshwork_core::fit::rbf::{Kernel, Rbf};
+use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
+use meshwork_core::fit::{run, FitParams};
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::shapes::subdivide_midpoint;
+use meshwork_core::Progress;
+
+fn planes(extra: bool) -> Vec<(Point3, f64)> {
+    let mut ys = vec![0.3013, 0.4517, 0.6021, 0.7519, 0.9011];
+    if extra {
+        ys.extend([0.3761, 0.5263, 0.6773, 0.8261]);
+    }
+    let mut p: Vec<(Point3, f64)> = ys.iter().map(|&y| ([0.0, 1.0, 0.0], y)).collect();
+    p.push(([1.0, 0.0, 0.0], 0.4987));
+    p.push(([0.0, 0.0, 1.0], 0.4919));
+    p
+}
+
+struct Case {
+    template: Mesh,
+    curves: Mesh,
+    params: FitParams,
+}
+
+fn case(homer: &Mesh, split: u32, thin: usize, extra_planes: bool, smooth: bool) -> Case {
+    let sections = thin_network(&plane_sections(homer, &planes(extra_planes)), thin);
+    let template = subdivide_midpoint(homer, split);
+    let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
+    let mut curves = sections;
+    for p in curves.positions.iter_mut() {
+        *p = bend(*p, 1.0);
+    }
+    Case { template, curves, params: FitParams { pairs, smooth, ..Default::default() } }
+}
+
+/// Best of `reps` runs; returns the report of the best.
+fn time_fit(c: &Case, reps: usize) -> (f64, serde_json::Value) {
+    let mut best = (f64::INFINITY, serde_json::Value::Null);
+    for _ in 0..reps {
+        let t = Instant::now();
+        let out = run(vec![c.template.clone(), c.curves.clone()], &c.params, &Progress::new()).expect("fit");
+        let s = t.elapsed().as_secs_f64();
+        if s < best.0 {
+            best = (s, out.report);
+        }
+    }
+    best
+}
+
+fn line(label: &str, s: f64, r: &serde_json::Value) {
+    let st = &r["stages"];
+    println!(
+        "{label:<34} {:>7} tmpl V {:>5} curve V {:>7.3} s | curves {:>6.1} coarse {:>6.1} fine {:>6.1} retri {:>6.1} part {:>5.1} smooth {:>6.1} ms | edges {:.4} flipped {} regions {} minangle {:.1}→{:.1}",
+        r["template_vertices"],
+        r["curve_vertices"],
+        s,
+        st["curves"].as_f64().unwrap_or(0.0),
+        st["coarse"].as_f64().unwrap_or(0.0),
+        st["fine"].as_f64().unwrap_or(0.0),
+        st["retriangulate"].as_f64().unwrap_or(0.0),
+        st["partition"].as_f64().unwrap_or(0.0),
+        st["smooth"].as_f64().unwrap_or(0.0),
+        r["segments_as_edges"].as_f64().unwrap_or(0.0),
+        r["flipped_faces"],
+        r["regions"],
+        r["min_angle_deg_before_smoothing"].as_f64().unwrap_or(0.0),
+        r["min_angle_deg_after_smoothing"].as_f64().unwrap_or(0.0),
+    );
+}
+
+fn main() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let bytes = std::fs::read("../shared/meshes/homer.obj").expect("run from the repository root");
+    let homer = read(&bytes, &ReadOptions::default()).expect("homer").mesh;
+
+    println!("== headline: 96k-vertex template, full section network ==");
+    for smooth in [false, true] {
+        let c = case(&homer, 2, 1, true, smooth);
+        let (s, r) = time_fit(&c, 3);
+        line(if smooth { "96k, all points, smoothing" } else { "96k, all points, no smoothing" }, s, &r);
+        if std::env::args().any(|a| a == "--report") {
+            println!("{}", serde_json::to_string_pretty(&r).unwrap());
+        }
+    }
+    if std::env::args().any(|a| a == "--headline") {
+        return;
+    }
+
+    println!("== growth with template size (curves: every 2nd section point) ==");
+    for split in [0, 1, 2] {
+        let c = case(&homer, split, 2, true, true);
+        let (s, r) = time_fit(&c, 3);
+        line(&format!("homer split {split}"), s, &r);
+    }
+
+    println!("== growth with curve vertices (96k template) ==");
+    for (thin, extra) in [(4, false), (2, false), (1, false), (1, true)] {
+        let c = case(&homer, 2, thin, extra, true);
+        let (s, r) = time_fit(&c, 3);
+        line(&format!("every {thin}, {} planes", if extra { 11 } else { 7 }), s, &r);
+    }
+
+    println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
+    let c = case(&homer, 2, 1, true, false);
+    rbf_peer(&c);
+}
+
+/// Times our RBF (solve + evaluate at every template vertex) and SciPy's on the same centres.
+fn rbf_peer(c: &Case) {
+    // The fine-level problem: centres = curve points, values = a smooth displacement.
+    let centres: Vec<Point3> = {
+        let net = meshwork_core::fit::curves::CurveNetwork::from_mesh(&c.curves, 1e-6).unwrap();
+        net.points
+    };
+    let values: Vec<Point3> = centres.iter().map(|p| [0.1 * p[1].sin(), 0.05 * p[0] * p[2], -0.02 * p[1]]).collect();
+    let points = &c.template.positions;
+    let mut best = f64::INFINITY;
+    let mut ours = Vec::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        let f = Rbf::fit(&centres, &values, Kernel::Linear, "bench").unwrap();
+        ours = f.eval_many(points, &Progress::new()).unwrap();
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    println!("meshwork rbf: {} centres, {} points: {:.3} s", centres.len(), points.len(), best);
+    let py = std::path::Path::new(&std::env::var("HOME").unwrap_or_default()).join(".cache/meshwork-peers/bin/python");
+    if !py.exists() {
+        println!("scipy peer: venv not installed, skipped");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("bench_fit_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, v: &[Point3]| {
+        let bytes: Vec<u8> = v.iter().flat_map(|p| p.iter().flat_map(|x| x.to_le_bytes())).collect();
+        std::fs::write(dir.join(name), bytes).unwrap();
+    };
+    write("c.bin", &centres);
+    write("v.bin", &values);
+    write("p.bin", points);
+    let script = r#"
+import sys, time, numpy as np
+from scipy.interpolate import RBFInterpolator
+d = sys.argv[1]
+c = np.fromfile(d + '/c.bin').reshape(-1, 3); v = np.fromfile(d + '/v.bin').reshape(-1, 3)
+p = np.fromfile(d + '/p.bin').reshape(-1, 3)
+best = 1e9
+for _ in range(3):
+    t = time.perf_counter()
+    out = RBFInterpolator(c, v, kernel='linear', degree=1)(p)
+    best = min(best, time.perf_counter() - t)
+out.tofile(d + '/o.bin')
+print(best)
+"#;
+    std::fs::write(dir.join("peer.py"), script).unwrap();
+    let o = std::process::Command::new(py).arg(dir.join("peer.py")).arg(&dir).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    match stdout.trim().parse::<f64>() {
+        Ok(s) => {
+            let theirs: Vec<f64> = std::fs::read(dir.join("o.bin"))
+                .unwrap()
+                .chunks(8)
+                .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                .collect();
+            let diff = ours.iter().flat_map(|p| p.iter()).zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            println!("scipy rbf: {s:.3} s  (ratio scipy/meshwork {:.2}; max |difference| {diff:.2e})", s / best);
+        }
+        Err(_) => println!("scipy peer failed: {}", String::from_utf8_lossy(&o.stderr)),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
