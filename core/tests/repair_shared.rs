@@ -321,3 +321,14 @@ fn face_groups_survive_and_patches_take_their_neighbours_group() {
     assert_eq!(out.faces.groups().iter().filter(|&&g| g == 1).count(), south);
     assert_eq!(out.groups, vec!["north".to_string(), "south".to_string()]);
 }
+
+#[test]
+fn clean_closed_mesh_passes_through_unchanged() {
+    let m = shapes::torus(16, 8, 2.0, 0.5, true);
+    let (out, rep) = repair(m.clone(), Value::Null);
+    assert_eq!(out, m);
+    assert!(rep["steps"]["orient"]["skipped"].is_string());
+    assert!(rep["steps"]["fill_holes"]["skipped"].is_string());
+    assert_eq!(rep["output"]["genus"], 1);
+    assert_eq!(rep["manifold"], true);
+}

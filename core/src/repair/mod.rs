@@ -191,60 +191,93 @@ pub fn run(mut mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result
     let mut steps = serde_json::Map::new();
     let diag = input.bbox_diagonal;
 
+    // `dirty`: the faces changed since `input` was analysed. While false, a step whose problem the
+    // input report shows absent is skipped (said so in its report) instead of rebuilding topology.
+    let mut dirty = false;
+    let skipped = |why: &str| serde_json::json!({ "skipped": why });
     if params.weld {
         let r =
             stages.run(progress, "weld", || weld::weld(&mut mesh, params.weld_tolerance * diag, progress))?;
+        dirty |= r.merged_vertices > 0;
         steps.insert("weld".into(), to_json(&r));
     }
     if params.remove_degenerate || params.remove_duplicates {
         let r = stages.run(progress, "clean", || {
             Ok(clean::clean(&mut mesh, params.remove_degenerate, params.remove_duplicates, diag))
         })?;
+        dirty |=
+            r.collapsed_corners + r.dropped_repeated_index + r.dropped_zero_area + r.dropped_duplicates > 0;
         steps.insert("clean".into(), to_json(&r));
     }
     if params.non_manifold != NonManifoldMode::Keep {
-        let r = stages.run(progress, "non_manifold", || {
-            nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
-        })?;
-        steps.insert("non_manifold".into(), to_json(&r));
+        if !dirty && input.non_manifold_edges == 0 && input.non_manifold_vertices == 0 {
+            steps.insert("non_manifold".into(), skipped("input has no non-manifold edges or vertices"));
+        } else {
+            let r = stages.run(progress, "non_manifold", || {
+                nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
+            })?;
+            dirty |= r.vertices_added + r.faces_removed > 0;
+            steps.insert("non_manifold".into(), to_json(&r));
+        }
     }
     if params.orient {
-        let r = stages.run(progress, "orient", || Ok(orient::make_consistent(&mut mesh)))?;
-        steps.insert("orient".into(), to_json(&r));
+        if !dirty && input.inconsistent_orientation == 0 {
+            steps.insert("orient".into(), skipped("input is consistently oriented"));
+        } else {
+            let r = stages.run(progress, "orient", || Ok(orient::make_consistent(&mut mesh)))?;
+            dirty |= r.faces_flipped > 0;
+            steps.insert("orient".into(), to_json(&r));
+        }
     }
     if params.min_component_faces > 0 || params.keep_largest {
         let r = stages.run(progress, "components", || {
             Ok(components::remove_small(&mut mesh, params.min_component_faces, params.keep_largest))
         })?;
+        dirty |= r.faces_removed > 0;
         steps.insert("components".into(), to_json(&r));
     }
     let mut holes_report = None;
     if params.fill_holes {
-        let r = stages.run(progress, "fill_holes", || {
-            holes::fill(&mut mesh, &holes::FillOptions::from(params), progress)
-        })?;
-        steps.insert("fill_holes".into(), to_json(&r));
-        // A filled hole that touched a skipped one at a vertex leaves a closed fan next to an open
-        // one there (a non-manifold vertex the fill created): resolve those the same way.
-        if r.filled > 0 && params.non_manifold != NonManifoldMode::Keep {
-            let n = stages.run(progress, "non_manifold_after_fill", || {
-                nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
+        if !dirty && input.boundary_edges == 0 {
+            steps.insert("fill_holes".into(), skipped("input has no boundary"));
+        } else {
+            let r = stages.run(progress, "fill_holes", || {
+                holes::fill(&mut mesh, &holes::FillOptions::from(params), progress)
             })?;
-            steps.insert("non_manifold_after_fill".into(), to_json(&n));
+            dirty |= r.filled > 0;
+            steps.insert("fill_holes".into(), to_json(&r));
+            // A filled hole that touched a skipped one at a vertex leaves a closed fan next to an
+            // open one there (a non-manifold vertex the fill created): resolve those the same way.
+            if r.filled > 0 && params.non_manifold != NonManifoldMode::Keep {
+                let n = stages.run(progress, "non_manifold_after_fill", || {
+                    nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
+                })?;
+                steps.insert("non_manifold_after_fill".into(), to_json(&n));
+            }
+            holes_report = Some(r);
         }
-        holes_report = Some(r);
     }
     if params.orient && params.outward {
-        let r = stages.run(progress, "outward", || Ok(orient::outward(&mut mesh)))?;
-        steps.insert("outward".into(), to_json(&r));
+        if !dirty && input.components == 1 && input.volume.is_some_and(|v| v > 0.0) {
+            steps.insert("outward".into(), skipped("input is one closed component with positive volume"));
+        } else {
+            let r = stages.run(progress, "outward", || Ok(orient::outward(&mut mesh)))?;
+            dirty |= r.components_flipped > 0;
+            steps.insert("outward".into(), to_json(&r));
+        }
     }
     if params.remove_unreferenced {
         let r = stages.run(progress, "compact", || Ok(clean::compact(&mut mesh)))?;
+        dirty |= r.removed_vertices > 0;
         vmap.then(&r.map);
         steps.insert("unreferenced".into(), to_json(&r));
     }
 
-    let out = stages.run(progress, "validate_output", || Ok(validate::analyze(&mesh)))?;
+    let out = if dirty {
+        stages.run(progress, "validate_output", || Ok(validate::analyze(&mesh)))?
+    } else {
+        input.clone()
+    };
     let why = why_not(&out, holes_report.as_ref(), params);
     if params.require_manifold && !(out.manifold && out.pinch_vertices == 0) {
         return Err(Error::Topology(format!("repaired mesh is not manifold: {}", why.join("; "))));
