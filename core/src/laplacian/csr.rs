@@ -55,27 +55,34 @@ impl Csr {
         worst
     }
 
-    /// y = A·x for `k` interleaved columns (x[i*k + c]), rows in parallel for large matrices.
+    /// y = A·x for `k` ≤ 4 interleaved columns (x[i*k + c]), rows in parallel for large matrices.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64], k: usize) {
-        debug_assert_eq!(x.len(), self.n * k);
-        debug_assert_eq!(y.len(), self.n * k);
+        assert!(x.len() == self.n * k && y.len() == self.n * k, "mul_vec: sizes");
+        match k {
+            1 => self.mul::<1>(x, y),
+            2 => self.mul::<2>(x, y),
+            3 => self.mul::<3>(x, y),
+            4 => self.mul::<4>(x, y),
+            _ => panic!("mul_vec supports 1 to 4 interleaved columns"),
+        }
+    }
+
+    fn mul<const K: usize>(&self, x: &[f64], y: &mut [f64]) {
         let row = |(i, yi): (usize, &mut [f64])| {
             let (a, b) = (self.row_ptr[i] as usize, self.row_ptr[i + 1] as usize);
-            let mut acc = [0.0f64; 4];
-            for p in a..b {
-                let j = self.col[p] as usize;
-                let v = self.val[p];
-                for c in 0..k {
-                    acc[c] += v * x[j * k + c];
+            let mut acc = [0.0f64; K];
+            for (&j, &v) in self.col[a..b].iter().zip(&self.val[a..b]) {
+                let xj = &x[j as usize * K..j as usize * K + K];
+                for c in 0..K {
+                    acc[c] += v * xj[c];
                 }
             }
-            yi.copy_from_slice(&acc[..k]);
+            yi.copy_from_slice(&acc);
         };
-        assert!(k <= 4, "mul_vec supports up to 4 interleaved columns");
         if self.n >= PAR_ROWS {
-            y.par_chunks_mut(k).enumerate().with_min_len(1024).for_each(row);
+            y.par_chunks_mut(K).enumerate().with_min_len(2048).for_each(row);
         } else {
-            y.chunks_mut(k).enumerate().for_each(row);
+            y.chunks_mut(K).enumerate().for_each(row);
         }
     }
 

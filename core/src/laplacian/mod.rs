@@ -152,17 +152,31 @@ impl Stencil {
         if total >= EDGE_FLAG as usize || 2 * total >= u32::MAX as usize {
             return Err(too_large("operator pairs", total));
         }
-        // Directed entries (row, col, pair) by counting sort on the row.
+        // Directed entries (row, col, pair) by counting sort on the row. Triangle meshes take a
+        // direct loop (this is the hot path of every assembly from scratch).
         let mut count = vec![0u32; n + 1];
-        let each_pair =
-            |f: usize, g: &mut dyn FnMut(u32, u32, u32)| for_pairs(faces.get(f), pair_offset[f], layout, g);
-        for f in 0..nf {
-            each_pair(f, &mut |a, b, _| {
-                if a != b {
-                    count[a as usize + 1] += 1;
-                    count[b as usize + 1] += 1;
+        let tris = faces.as_triangles();
+        if let Some(t) = tris {
+            for &v in t {
+                count[v as usize + 1] += 2;
+            }
+            // Repeated corners (a == b) would be skipped below: uncount them.
+            for t in t.chunks_exact(3) {
+                for c in 0..3 {
+                    if t[c] == t[(c + 1) % 3] {
+                        count[t[c] as usize + 1] -= 2;
+                    }
                 }
-            });
+            }
+        } else {
+            for f in 0..nf {
+                for_pairs(faces.get(f), pair_offset[f], layout, &mut |a, b, _| {
+                    if a != b {
+                        count[a as usize + 1] += 1;
+                        count[b as usize + 1] += 1;
+                    }
+                });
+            }
         }
         for i in 0..n {
             count[i + 1] += count[i];
@@ -171,15 +185,25 @@ impl Stencil {
         let mut fill = count;
         let m = ent_ptr[n] as usize;
         let mut ent: Vec<(u32, u32)> = vec![(0, 0); m];
-        for f in 0..nf {
-            each_pair(f, &mut |a, b, p| {
-                if a != b {
-                    ent[fill[a as usize] as usize] = (b, p);
-                    fill[a as usize] += 1;
-                    ent[fill[b as usize] as usize] = (a, p);
-                    fill[b as usize] += 1;
-                }
-            });
+        let mut put = |a: u32, b: u32, p: u32| {
+            if a != b {
+                ent[fill[a as usize] as usize] = (b, p);
+                fill[a as usize] += 1;
+                ent[fill[b as usize] as usize] = (a, p);
+                fill[b as usize] += 1;
+            }
+        };
+        if let Some(t) = tris {
+            for (f, t) in t.chunks_exact(3).enumerate() {
+                let base = 3 * f as u32;
+                put(t[0], t[1], base | EDGE_FLAG);
+                put(t[1], t[2], (base + 1) | EDGE_FLAG);
+                put(t[2], t[0], (base + 2) | EDGE_FLAG);
+            }
+        } else {
+            for f in 0..nf {
+                for_pairs(faces.get(f), pair_offset[f], layout, &mut put);
+            }
         }
         // Per row: sort by column, count distinct columns (+ diagonal).
         let mut rows = split_rows_mut(&mut ent, &ent_ptr);

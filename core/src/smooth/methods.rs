@@ -15,25 +15,23 @@ use crate::spatial::Bvh;
 pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
     let mut x = ctx.mesh.positions.clone();
     match ctx.r.method {
-        Method::Laplacian => {
+        Method::Laplacian | Method::Taubin => {
             let rows = explicit_rows(ctx);
             let n = ctx.r.iterations as usize;
+            let factors: &[f64] =
+                if ctx.r.method == Method::Taubin { &[ctx.r.lambda, ctx.r.mu] } else { &[ctx.r.lambda] };
+            let mut out = x.clone();
+            let keep_before = ctx.r.axes != [true; 3];
             for it in 0..n {
                 ctx.tick(it, n)?;
-                let before = x.clone();
-                explicit_step(ctx, &rows, &mut x, ctx.r.lambda);
-                ctx.finish_step(&mut x, &before);
-            }
-        }
-        Method::Taubin => {
-            let rows = explicit_rows(ctx);
-            let n = ctx.r.iterations as usize;
-            for it in 0..n {
-                ctx.tick(it, n)?;
-                let before = x.clone();
-                explicit_step(ctx, &rows, &mut x, ctx.r.lambda);
-                explicit_step(ctx, &rows, &mut x, ctx.r.mu);
-                ctx.finish_step(&mut x, &before);
+                let before = if keep_before { x.clone() } else { Vec::new() };
+                for &f in factors {
+                    explicit_step(ctx, &rows, &x, &mut out, f);
+                    std::mem::swap(&mut x, &mut out);
+                }
+                if keep_before || ctx.r.preserve_volume {
+                    ctx.finish_step(&mut x, &before);
+                }
             }
         }
         Method::Implicit => implicit(ctx, &mut x, false)?,
@@ -48,8 +46,15 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
 /// Normalised explicit rows: `R = diag(S)⁻¹ S` (diagonal 1), boundary curve rows (½ of eq. 4-3,
 /// times `lambda_border`) in curve mode. One matrix for every operator, so λ ∈ (0, 1] is stable
 /// whatever the weights and the model's scale.
-fn explicit_rows(ctx: &Ctx) -> Csr {
+fn explicit_rows(ctx: &Ctx) -> Rows {
     let s = &ctx.op.stiffness;
+    if ctx.op.kind == OperatorKind::Uniform
+        && ctx.r.boundary != BoundaryMode::Curve
+        && ctx.stencil.layout == PairLayout::Edges
+    {
+        let inv_deg = s.diagonal().iter().map(|&d| if d > 0.0 { 1.0 / d } else { 0.0 }).collect();
+        return Rows::Umbrella { pattern: ctx.stencil.pattern.clone(), inv_deg };
+    }
     let mut r = s.clone();
     let curve = (ctx.r.boundary == BoundaryMode::Curve)
         .then(|| laplacian::boundary_curve_rows(&ctx.stencil, &ctx.mesh.positions, 1e-12 * ctx.edge_len));
@@ -72,22 +77,60 @@ fn explicit_rows(ctx: &Ctx) -> Csr {
             }
         }
     }
-    r
+    Rows::General(r)
 }
 
-/// `x_i ← x_i − f·w_i·(R x)_i` for moving vertices.
-fn explicit_step(ctx: &Ctx, rows: &Csr, x: &mut [Point3], f: f64) {
-    let mut y = vec![0.0; 3 * x.len()];
-    rows.mul_vec(x.as_flattened(), &mut y, 3);
+/// The explicit operator: general normalised rows, or the umbrella (uniform weights, no curve
+/// rows), whose off-diagonal entries are all −1/valence, so only column indices are read.
+enum Rows {
+    General(Csr),
+    Umbrella { pattern: Csr, inv_deg: Vec<f64> },
+}
+
+/// `out_i = x_i − f·w_i·(R x)_i` for moving vertices (Jacobi update into a second buffer, so one
+/// pass over the matrix and the positions per step).
+fn explicit_step(ctx: &Ctx, rows: &Rows, x: &[Point3], out: &mut [Point3], f: f64) {
     let (moving, w) = (&ctx.free.moving, &ctx.free.weight);
-    x.par_iter_mut().enumerate().with_min_len(8192).for_each(|(i, p)| {
-        if moving[i] {
-            let s = f * w[i];
-            for k in 0..3 {
-                p[k] -= s * y[3 * i + k];
+    let kernel = |(i, o): (usize, &mut Point3)| {
+        let xi = x[i];
+        if !moving[i] {
+            *o = xi;
+            return;
+        }
+        let mut acc = [0.0f64; 3];
+        match rows {
+            Rows::General(r) => {
+                let (a, b) = (r.row_ptr[i] as usize, r.row_ptr[i + 1] as usize);
+                for (&j, &v) in r.col[a..b].iter().zip(&r.val[a..b]) {
+                    let xj = x[j as usize];
+                    acc[0] += v * xj[0];
+                    acc[1] += v * xj[1];
+                    acc[2] += v * xj[2];
+                }
+            }
+            Rows::Umbrella { pattern, inv_deg } => {
+                let (a, b) = (pattern.row_ptr[i] as usize, pattern.row_ptr[i + 1] as usize);
+                for &j in &pattern.col[a..b] {
+                    let xj = x[j as usize];
+                    acc[0] += xj[0];
+                    acc[1] += xj[1];
+                    acc[2] += xj[2];
+                }
+                // The sum included x_i itself (the diagonal is in the pattern).
+                let s = inv_deg[i];
+                for k in 0..3 {
+                    acc[k] = xi[k] - s * (acc[k] - xi[k]);
+                }
             }
         }
-    });
+        let s = f * w[i];
+        *o = [xi[0] - s * acc[0], xi[1] - s * acc[1], xi[2] - s * acc[2]];
+    };
+    if x.len() >= 20_000 {
+        out.par_iter_mut().enumerate().with_min_len(4096).for_each(kernel);
+    } else {
+        out.iter_mut().enumerate().for_each(kernel);
+    }
 }
 
 /// Scale `d/w` of the implicit system (fixed vertices keep `d`; their rows are eliminated).

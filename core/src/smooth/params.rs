@@ -74,7 +74,7 @@ pub struct SmoothParams {
     pub mass: MassKind,
     /// Linear solver of implicit steps (default `auto`).
     pub solver: SolverChoice,
-    /// Relative residual at which CG stops (default 1e-10).
+    /// Relative residual at which CG stops (default 1e-8).
     pub cg_tolerance: Option<f64>,
     /// Rescale the moving vertices about the input's vertex centroid after every step so the
     /// enclosed volume (cone volume from the centroid for open meshes) stays that of the input.
@@ -202,7 +202,7 @@ impl SmoothParams {
                 _ => OperatorKind::Cotan,
             }),
         };
-        let cg_tolerance = finite("cg_tolerance", self.cg_tolerance.unwrap_or(1e-10))?;
+        let cg_tolerance = finite("cg_tolerance", self.cg_tolerance.unwrap_or(1e-8))?;
         if !(cg_tolerance > 0.0 && cg_tolerance < 1.0) {
             return Err(Error::params("cg_tolerance", "must be in (0, 1)"));
         }

@@ -12,7 +12,7 @@ use crate::mesh::Point3;
 use crate::solve::{pcg, Cholesky, Dirichlet, SolverChoice};
 
 /// Below this many unknowns `auto` always factors (Cholesky is fast and exact there).
-pub const AUTO_CG_MIN_UNKNOWNS: usize = 50_000;
+pub const AUTO_CG_MIN_UNKNOWNS: usize = 20_000;
 /// `auto` uses CG when the estimated CG iterations over the whole job stay below this.
 pub const AUTO_CG_MAX_TOTAL_ITERATIONS: f64 = 400.0;
 const CG_MAX_ITER: usize = 2000;
