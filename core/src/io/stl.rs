@@ -265,7 +265,10 @@ fn hash_of<K: Hash>(k: &K) -> u64 {
 /// shard, in parallel, maps every corner to the first corner with the same key; a final pass in
 /// corner order numbers those first corners. Small per-shard tables also stay in cache, which
 /// matters more than the second core.
-fn weld_by<K: Hash + Eq + Send>(corners: &[[f64; 3]], key: impl Fn(&[f64; 3]) -> K + Sync) -> (Vec<[f64; 3]>, Vec<u32>) {
+fn weld_by<K: Hash + Eq + Send>(
+    corners: &[[f64; 3]],
+    key: impl Fn(&[f64; 3]) -> K + Sync,
+) -> (Vec<[f64; 3]>, Vec<u32>) {
     let n = corners.len();
     let mut first: Vec<u32> = if n < SHARDED_WELD_MIN {
         first_corners(corners, (0..n as u32).collect::<Vec<_>>().as_slice(), &key)
@@ -288,15 +291,23 @@ fn weld_by<K: Hash + Eq + Send>(corners: &[[f64; 3]], key: impl Fn(&[f64; 3]) ->
 
 /// For the corners `subset` (ascending), the first corner of `subset` with the same key, indexed
 /// like `subset`.
-fn first_corners<K: Hash + Eq>(corners: &[[f64; 3]], subset: &[u32], key: &impl Fn(&[f64; 3]) -> K) -> Vec<u32> {
+fn first_corners<K: Hash + Eq>(
+    corners: &[[f64; 3]],
+    subset: &[u32],
+    key: &impl Fn(&[f64; 3]) -> K,
+) -> Vec<u32> {
     let mut map: HashMap<K, u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
     map.reserve(subset.len() / 6 + 16);
     subset.iter().map(|&c| *map.entry(key(&corners[c as usize])).or_insert(c)).collect()
 }
 
-fn sharded_first_corners<K: Hash + Eq + Send>(corners: &[[f64; 3]], key: &(impl Fn(&[f64; 3]) -> K + Sync)) -> Vec<u32> {
+fn sharded_first_corners<K: Hash + Eq + Send>(
+    corners: &[[f64; 3]],
+    key: &(impl Fn(&[f64; 3]) -> K + Sync),
+) -> Vec<u32> {
     const SHARDS: usize = 64;
-    let shard: Vec<u8> = corners.par_iter().map(|p| ((hash_of(&key(p)) >> 32) as usize % SHARDS) as u8).collect();
+    let shard: Vec<u8> =
+        corners.par_iter().map(|p| ((hash_of(&key(p)) >> 32) as usize % SHARDS) as u8).collect();
     // Corners grouped by shard, ascending within each (a counting sort).
     let mut start = [0usize; SHARDS + 1];
     for &s in &shard {
@@ -312,8 +323,10 @@ fn sharded_first_corners<K: Hash + Eq + Send>(corners: &[[f64; 3]], key: &(impl 
         fill[s as usize] += 1;
     }
     drop(shard);
-    let per_shard: Vec<Vec<u32>> =
-        (0..SHARDS).into_par_iter().map(|s| first_corners(corners, &order[start[s]..start[s + 1]], key)).collect();
+    let per_shard: Vec<Vec<u32>> = (0..SHARDS)
+        .into_par_iter()
+        .map(|s| first_corners(corners, &order[start[s]..start[s + 1]], key))
+        .collect();
     let mut first = vec![0u32; corners.len()];
     for (s, reps) in per_shard.iter().enumerate() {
         for (&c, &r) in order[start[s]..start[s + 1]].iter().zip(reps) {
@@ -368,8 +381,9 @@ mod tests {
             state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (state >> 33) as usize
         };
-        let distinct: Vec<[f64; 3]> =
-            (0..30_000).map(|i| [(i % 50) as f64 * 0.5, (i / 50 % 30) as f64 * 0.25, (i / 1500) as f64]).collect();
+        let distinct: Vec<[f64; 3]> = (0..30_000)
+            .map(|i| [(i % 50) as f64 * 0.5, (i / 50 % 30) as f64 * 0.25, (i / 1500) as f64])
+            .collect();
         let mut corners: Vec<[f64; 3]> = (0..200_000).map(|_| distinct[next() % distinct.len()]).collect();
         corners[7] = [-0.0, 0.0, 0.0];
         corners[8] = [0.0, -0.0, 0.0];
