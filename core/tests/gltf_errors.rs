@@ -384,3 +384,21 @@ fn mutated_json_numbers_never_panic() {
     }
     assert!(refused > 1000, "most mutations should be refused, only {refused} were");
 }
+
+#[test]
+fn reused_accessors_are_bounded_by_the_limits() {
+    // 200 LINE_STRIP primitives all reusing one 3-index accessor: 200 × 4 curve entries > a limit of 3 × 100.
+    let (bin, mut d) = triangle();
+    d["meshes"][0]["primitives"] =
+        json!(vec![json!({ "attributes": { "POSITION": 0 }, "indices": 1, "mode": 3 }); 200]);
+    let opts = ReadOptions { max_faces: 100, ..Default::default() };
+    let e = read(&glb(&d, &bin.bytes), &opts).unwrap_err();
+    assert_eq!(e.kind(), "too-large", "{e}");
+    // The same with TRIANGLES: 200 faces > 100.
+    d["meshes"][0]["primitives"] = json!(vec![json!({ "attributes": { "POSITION": 0 }, "indices": 1 }); 200]);
+    let e = read(&glb(&d, &bin.bytes), &opts).unwrap_err();
+    assert_eq!(e.kind(), "too-large", "{e}");
+    // Within the limits, both read fine and share one vertex block.
+    let l = read(&glb(&d, &bin.bytes), &ReadOptions::default()).unwrap();
+    assert_eq!((l.mesh.vertex_count(), l.mesh.face_count()), (3, 200));
+}

@@ -58,6 +58,16 @@ enum Cmd {
         #[arg(long, default_value_t = 5)]
         repeat: usize,
     },
+    /// Write a test mesh: a torus of NU×NV vertices (triangles), e.g. 400×250 = 100k vertices
+    GenTorus {
+        #[arg(long, default_value_t = 400)]
+        nu: usize,
+        #[arg(long, default_value_t = 250)]
+        nv: usize,
+        /// Output file; format from the extension
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 #[derive(Default)]
@@ -82,6 +92,14 @@ fn main() {
             run_http(&target, body, &ctype, concurrency, Duration::from_secs_f64(duration), server_pid, api_key);
         }
         Cmd::Inprocess { job, file, params, repeat } => run_inprocess(&job, &file, &params, repeat),
+        Cmd::GenTorus { nu, nv, output } => {
+            let mesh = meshwork_core::shapes::torus(nu, nv, 1.0, 0.3, false);
+            let name = output.display().to_string();
+            let format = meshwork_core::io::Format::from_name(&name).unwrap_or_else(|| die("unknown extension"));
+            let bytes = meshwork_core::io::write(&mesh, format).unwrap_or_else(|e| die(&e.to_string()));
+            std::fs::write(&output, bytes).unwrap_or_else(|e| die(&e.to_string()));
+            println!("{name}: {} vertices, {} faces", mesh.vertex_count(), mesh.face_count());
+        }
     }
 }
 

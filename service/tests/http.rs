@@ -367,3 +367,77 @@ fn validate_repair_and_smooth_through_http() {
     let p = s.post("/v1/smooth?method=bogus", "model/obj", &fandisk).problem(422, "invalid-params");
     assert_eq!(p["field"], "method", "{p}");
 }
+
+fn obj_of(mesh: &meshwork_core::Mesh) -> Vec<u8> {
+    meshwork_core::io::write(mesh, meshwork_core::io::Format::Obj).unwrap()
+}
+
+#[test]
+fn morph_answers_its_animated_glb_and_refuses_genus_one() {
+    use meshwork_core::shapes;
+    let s = Server::start(&[]);
+    let a = obj_of(&shapes::icosphere(2, 1.0));
+    let mut e = shapes::icosphere(1, 1.0);
+    for p in &mut e.positions {
+        p[0] *= 2.0;
+    }
+    let b = obj_of(&e);
+    // Asked for OBJ, but morph's result is the animated GLB it builds (its artifact).
+    let r = s.post_multipart("/v1/morph?frames=4&format=obj", &[file_part("mesh", "a.obj", &a), file_part("mesh", "b.obj", &b)]);
+    assert_eq!(r.status, 200, "{}", r.text());
+    assert_eq!(r.header("content-type"), Some("model/gltf-binary"));
+    assert_eq!(&r.body[..4], b"glTF");
+    let glb = read(&r.body, &ReadOptions::default()).expect("our own GLB reads back").mesh;
+    assert!(glb.vertex_count() >= 42, "the base mesh holds at least the first input's vertices");
+    // A torus is genus 1: the morph refuses it, saying so.
+    let t = obj_of(&shapes::torus(12, 8, 1.0, 0.3, false));
+    let p = s
+        .post_multipart("/v1/morph", &[file_part("mesh", "a.obj", &a), file_part("mesh", "t.obj", &t)])
+        .problem(422, "unsupported-topology");
+    assert!(p["detail"].as_str().unwrap().contains("genus"), "{p}");
+    // Only one input.
+    s.post_multipart("/v1/morph", &[file_part("mesh", "a.obj", &a)]).problem(422, "invalid-params");
+}
+
+/// A wavy line across the unit square and a closed circle, as OBJ `l` polylines (the curves of
+/// core/tests/fit_plane.rs): they cut the plane into 3 regions.
+fn plane_curves_obj() -> String {
+    let mut s = String::new();
+    for k in 0..=12 {
+        let x = k as f64 / 12.0;
+        s += &format!("v {x} {} 0\n", 0.2 + 0.04 * (6.0 * x).sin());
+    }
+    for k in 0..24 {
+        let t = std::f64::consts::TAU * k as f64 / 24.0;
+        s += &format!("v {} {} 0\n", 0.55 + 0.22 * t.cos(), 0.6 + 0.22 * t.sin());
+    }
+    s += &format!("l {}\n", (1..=13).map(|i| i.to_string()).collect::<Vec<_>>().join(" "));
+    s += &format!("l {} 14\n", (14..=37).map(|i| i.to_string()).collect::<Vec<_>>().join(" "));
+    s
+}
+
+#[test]
+fn fit_takes_template_and_curves_parts() {
+    let s = Server::start(&["--max-curve-points", "30"]);
+    let template = obj_of(&meshwork_core::shapes::grid(24, 24, 1.0 / 24.0, false));
+    let curves = plane_curves_obj();
+    let params = r#"{"alignment": "none", "coplanar_centres": "augment"}"#;
+    // 38 curve points > the limit of 30: refused before the job runs, naming the limit.
+    let p = s
+        .post_multipart("/v1/fit", &[file_part("template", "grid.obj", &template), file_part("curves", "c.obj", curves.as_bytes()), json_part("params", params)])
+        .problem(413, "too-large");
+    assert!(p["detail"].as_str().unwrap().contains("curve points"), "{p}");
+    let s = Server::start(&[]);
+    // Parts in the "wrong" order still map by name.
+    let r = s.post_multipart(
+        "/v1/fit?format=obj&report=inline",
+        &[file_part("curves", "c.obj", curves.as_bytes()), json_part("params", params), file_part("template", "grid.obj", &template)],
+    );
+    assert_eq!(r.status, 200, "{}", r.text());
+    let parts = split_mixed(r.header("content-type").unwrap(), &r.body);
+    let report: serde_json::Value = serde_json::from_slice(&parts[0].1).unwrap();
+    assert_eq!(report["regions"], 3, "{report}");
+    let m = read_obj(&parts[1].1);
+    assert_eq!(m.groups.len(), 3, "the three regions survive as OBJ groups");
+    assert!(m.positions.iter().all(|p| p[2].abs() < 1e-6), "the plane stays z = 0");
+}

@@ -295,7 +295,7 @@ impl<'a> Reader<'a> {
                     let group = out.group(name, synthesized);
                     self.triangles(&mut out, prim, &indices, block.base, group, flip)?;
                 } else {
-                    self.lines(&mut out, prim, &indices, block.base);
+                    self.lines(&mut out, prim, &indices, block.base)?;
                 }
             }
         }
@@ -517,7 +517,17 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    fn lines(&mut self, out: &mut Out, prim: &Prim, idx: &[u32], base: u32) {
+    fn lines(&mut self, out: &mut Out, prim: &Prim, idx: &[u32], base: u32) -> Result<()> {
+        // Many primitives may reuse one big index accessor: bound the total like faces' indices.
+        let limit = self.opts.max_faces.saturating_mul(3);
+        out.curve_indices = out.curve_indices.saturating_add(idx.len() + 1);
+        if out.curve_indices > limit {
+            return Err(Error::TooLarge {
+                what: "curve vertices".into(),
+                limit: limit as u64,
+                actual: out.curve_indices as u64,
+            });
+        }
         let shifted = idx.iter().map(|&i| i + base);
         match prim.mode {
             1 => {
@@ -551,6 +561,7 @@ impl<'a> Reader<'a> {
                 .warnings
                 .push(format!("{}: a line strip/loop needs 2 or more vertices, skipped", prim.path)),
         }
+        Ok(())
     }
 }
 
@@ -579,6 +590,8 @@ struct Out {
     synthesized: Vec<bool>,
     by_name: HashMap<String, u32>,
     degenerate: usize,
+    /// Vertex references in all curves so far (bounded by the face-index limit).
+    curve_indices: usize,
 }
 
 impl Out {
@@ -593,6 +606,7 @@ impl Out {
             synthesized: Vec::new(),
             by_name: HashMap::new(),
             degenerate: 0,
+            curve_indices: 0,
         }
     }
 
