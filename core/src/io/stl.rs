@@ -8,6 +8,8 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hash, Hasher};
 
+use rayon::prelude::*;
+
 use super::lex::{self, Tokens};
 use super::{Format, Loaded, ReadOptions};
 use crate::error::{Error, Location, Result};
@@ -247,21 +249,91 @@ fn weld(soup: Soup, groups: Vec<String>) -> Loaded {
     Loaded { mesh: Mesh { positions, faces, groups, ..Default::default() }, format: Format::Stl, warnings }
 }
 
-/// Positions in first-occurrence order and each corner's vertex id. A closed triangle mesh has
-/// about one vertex per 6 corners, which sizes the table (it grows if there are more).
-fn weld_by<K: Hash + Eq>(corners: &[[f64; 3]], key: impl Fn(&[f64; 3]) -> K) -> (Vec<[f64; 3]>, Vec<u32>) {
-    let mut map: HashMap<K, u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
-    map.reserve(corners.len() / 6 + 16);
-    let mut positions = Vec::with_capacity(corners.len() / 6 + 16);
-    let mut index = Vec::with_capacity(corners.len());
-    for p in corners {
-        let id = *map.entry(key(p)).or_insert_with(|| {
-            positions.push(*p);
+/// Corners per shard below which welding runs in one table on one thread.
+const SHARDED_WELD_MIN: usize = 1 << 16;
+
+fn hash_of<K: Hash>(k: &K) -> u64 {
+    let mut h = BitsHasher::default();
+    k.hash(&mut h);
+    h.finish()
+}
+
+/// Positions in first-occurrence order and each corner's vertex id.
+///
+/// Large inputs are welded in 64 shards chosen by 6 middle bits of the key's hash (the table uses
+/// the low bits for buckets and the top 7 for tags, so those stay varied within a shard). Each
+/// shard, in parallel, maps every corner to the first corner with the same key; a final pass in
+/// corner order numbers those first corners. Small per-shard tables also stay in cache, which
+/// matters more than the second core.
+fn weld_by<K: Hash + Eq + Send>(
+    corners: &[[f64; 3]],
+    key: impl Fn(&[f64; 3]) -> K + Sync,
+) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let n = corners.len();
+    let mut first: Vec<u32> = if n < SHARDED_WELD_MIN {
+        first_corners(corners, (0..n as u32).collect::<Vec<_>>().as_slice(), &key)
+    } else {
+        sharded_first_corners(corners, &key)
+    };
+    // `first[c] <= c`, so numbering in corner order can overwrite `first` in place.
+    let mut positions = Vec::with_capacity(n / 6 + 16);
+    for c in 0..n {
+        let r = first[c] as usize;
+        first[c] = if r == c {
+            positions.push(corners[c]);
             (positions.len() - 1) as u32
-        });
-        index.push(id);
+        } else {
+            first[r]
+        };
     }
-    (positions, index)
+    (positions, first)
+}
+
+/// For the corners `subset` (ascending), the first corner of `subset` with the same key, indexed
+/// like `subset`.
+fn first_corners<K: Hash + Eq>(
+    corners: &[[f64; 3]],
+    subset: &[u32],
+    key: &impl Fn(&[f64; 3]) -> K,
+) -> Vec<u32> {
+    let mut map: HashMap<K, u32, BuildHasherDefault<BitsHasher>> = HashMap::default();
+    map.reserve(subset.len() / 6 + 16);
+    subset.iter().map(|&c| *map.entry(key(&corners[c as usize])).or_insert(c)).collect()
+}
+
+fn sharded_first_corners<K: Hash + Eq + Send>(
+    corners: &[[f64; 3]],
+    key: &(impl Fn(&[f64; 3]) -> K + Sync),
+) -> Vec<u32> {
+    const SHARDS: usize = 64;
+    let shard: Vec<u8> =
+        corners.par_iter().map(|p| ((hash_of(&key(p)) >> 32) as usize % SHARDS) as u8).collect();
+    // Corners grouped by shard, ascending within each (a counting sort).
+    let mut start = [0usize; SHARDS + 1];
+    for &s in &shard {
+        start[s as usize + 1] += 1;
+    }
+    for s in 0..SHARDS {
+        start[s + 1] += start[s];
+    }
+    let mut order = vec![0u32; corners.len()];
+    let mut fill = start;
+    for (c, &s) in shard.iter().enumerate() {
+        order[fill[s as usize]] = c as u32;
+        fill[s as usize] += 1;
+    }
+    drop(shard);
+    let per_shard: Vec<Vec<u32>> = (0..SHARDS)
+        .into_par_iter()
+        .map(|s| first_corners(corners, &order[start[s]..start[s + 1]], key))
+        .collect();
+    let mut first = vec![0u32; corners.len()];
+    for (s, reps) in per_shard.iter().enumerate() {
+        for (&c, &r) in order[start[s]..start[s + 1]].iter().zip(reps) {
+            first[c as usize] = r;
+        }
+    }
+    first
 }
 
 /// Encodes `mesh` as binary STL: polygons are fan-triangulated (STL holds only triangles),
@@ -294,4 +366,43 @@ pub fn write(mesh: &Mesh) -> Result<Vec<u8>> {
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sharded weld against a plain std HashMap weld, on enough corners to shard, with values
+    /// whose low mantissa bits are zero and with -0.0 next to +0.0.
+    #[test]
+    fn sharded_weld_matches_a_plain_weld() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 33) as usize
+        };
+        let distinct: Vec<[f64; 3]> = (0..30_000)
+            .map(|i| [(i % 50) as f64 * 0.5, (i / 50 % 30) as f64 * 0.25, (i / 1500) as f64])
+            .collect();
+        let mut corners: Vec<[f64; 3]> = (0..200_000).map(|_| distinct[next() % distinct.len()]).collect();
+        corners[7] = [-0.0, 0.0, 0.0];
+        corners[8] = [0.0, -0.0, 0.0];
+        assert!(corners.len() >= SHARDED_WELD_MIN);
+        let (pos, idx) = weld_by(&corners, |p| Key64(p.map(|c| (c + 0.0).to_bits())));
+
+        let mut map = std::collections::HashMap::new();
+        let mut want_pos = Vec::new();
+        let want_idx: Vec<u32> = corners
+            .iter()
+            .map(|p| {
+                let k = p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+                *map.entry(k).or_insert_with(|| {
+                    want_pos.push(*p);
+                    want_pos.len() as u32 - 1
+                })
+            })
+            .collect();
+        assert_eq!(idx, want_idx);
+        assert_eq!(pos, want_pos);
+    }
 }
