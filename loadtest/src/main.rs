@@ -120,6 +120,7 @@ fn run_http(
     api_key: Option<String>,
 ) {
     let stop = Arc::new(AtomicBool::new(false));
+    let cpu0 = server_pid.and_then(|p| cpu_seconds(&p.to_string()));
     let start = Instant::now();
     let sampler = server_pid.map(|pid| {
         let stop = stop.clone();
@@ -173,6 +174,9 @@ fn run_http(
     println!("  other status  {}  {:?}", all.other.len(), summarize(&all.other));
     println!("transport errs  {}", all.transport);
     println!("latency ms      p50 {:.2}  p95 {:.2}  p99 {:.2}  max {:.2}", pct(50.0), pct(95.0), pct(99.0), pct(100.0));
+    if let (Some(c0), Some(c1)) = (cpu0, server_pid.and_then(|p| cpu_seconds(&p.to_string()))) {
+        println!("server CPU      {:.2} s, {:.2} ms per answered request", c1 - c0, (c1 - c0) * 1e3 / n.max(1) as f64);
+    }
     if let Some(s) = sampler {
         if let Ok((peak, samples, hwm)) = s.join() {
             let first = samples.first().copied().unwrap_or(0);
@@ -236,6 +240,17 @@ fn client_loop(target: &str, body: &[u8], ctype: &str, key: Option<&str>, stop: 
     t
 }
 
+/// CPU seconds (user + system) a process has used, from /proc (clock ticks at 100 Hz).
+fn cpu_seconds(pid: &str) -> Option<f64> {
+    let s = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let rest = s.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // After the command name: state is field 3, utime 14, stime 15 (1-based over the whole line).
+    let ut: f64 = f.get(11)?.parse().ok()?;
+    let st: f64 = f.get(12)?.parse().ok()?;
+    Some((ut + st) / 100.0)
+}
+
 fn proc_status_kb(pid: u32, key: &str) -> Option<u64> {
     let s = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
     s.lines().find(|l| l.starts_with(key))?.split_whitespace().nth(1)?.parse().ok()
@@ -248,6 +263,7 @@ fn run_inprocess(job: &str, file: &PathBuf, params: &str, repeat: usize) {
     let params: serde_json::Value = serde_json::from_str(params).unwrap_or_else(|e| die(&format!("params: {e}")));
     let bytes = std::fs::read(file).unwrap_or_else(|e| die(&format!("{}: {e}", file.display())));
     let mut times = Vec::new();
+    let cpu0 = cpu_seconds("self");
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
         let mesh = io::read(&bytes, &ReadOptions::default()).unwrap_or_else(|e| die(&e.to_string())).mesh;
@@ -256,6 +272,9 @@ fn run_inprocess(job: &str, file: &PathBuf, params: &str, repeat: usize) {
             let _ = io::write(&out.meshes[0], Format::Glb).unwrap_or_else(|e| die(&e.to_string()));
         }
         times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    if let (Some(c0), Some(c1)) = (cpu0, cpu_seconds("self")) {
+        println!("in-process CPU: {:.2} ms per run", (c1 - c0) * 1e3 / times.len() as f64);
     }
     times.sort_by(f64::total_cmp);
     println!("in-process {job} on {}: {} runs, median {:.1} ms, min {:.1} ms", file.display(), times.len(),
