@@ -73,6 +73,9 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
         None => Map::new(),
     };
     params = params::merge(params, extra);
+    if kind == JobKind::Fit {
+        pairs_from_file(&mut params)?;
+    }
 
     let out_format = if kind.returns_mesh() {
         let out = args.output.as_ref().ok_or_else(|| Failure::usage("error[usage]: -o OUT is required"))?;
@@ -158,7 +161,9 @@ fn read_params_file(path: &Path) -> Result<Map<String, Value>, Failure> {
         .map_err(|e| Failure::usage(format!("error[io]: cannot read {}: {e}", path.display())))?;
     match serde_json::from_str::<Value>(&text) {
         Ok(Value::Object(m)) => Ok(m),
-        Ok(_) => Err(Failure::usage(format!("error[invalid-params]: {} must hold a JSON object", path.display()))),
+        Ok(_) => {
+            Err(Failure::usage(format!("error[invalid-params]: {} must hold a JSON object", path.display())))
+        }
         Err(e) => Err(Failure::usage(format!("error[invalid-params]: {}: {e}", path.display()))),
     }
 }
@@ -166,14 +171,18 @@ fn read_params_file(path: &Path) -> Result<Map<String, Value>, Failure> {
 /// `--format` wins; else the output's extension; `-o -` defaults to GLB.
 fn output_format(out: &Path, flag: Option<&str>) -> Result<Format, Failure> {
     if let Some(f) = flag {
-        return Format::from_name(f).ok_or_else(|| Failure::usage(format!("error[usage]: unknown --format `{f}`")));
+        return Format::from_name(f)
+            .ok_or_else(|| Failure::usage(format!("error[usage]: unknown --format `{f}`")));
     }
     if out == Path::new("-") {
         return Ok(Format::Glb);
     }
     let name = out.file_name().and_then(|n| n.to_str()).unwrap_or("");
     if !name.contains('.') {
-        return Err(Failure::usage(format!("error[usage]: cannot tell the format of {}; add --format", out.display())));
+        return Err(Failure::usage(format!(
+            "error[usage]: cannot tell the format of {}; add --format",
+            out.display()
+        )));
     }
     Format::from_name(name).ok_or_else(|| {
         Failure::usage(format!("error[usage]: unknown output extension in {}; use --format", out.display()))
@@ -190,4 +199,25 @@ fn install_progress_line(progress: &Progress, job: &'static str) {
             eprint!("\r\x1b[2K{job}: {stage} {:3.0}%", fraction * 100.0);
         }
     });
+}
+
+/// `meshwork fit … --pairs PAIRS.json`: a string value of `pairs` names a file holding
+/// `{"pairs": [...]}` (or the bare array), which replaces it; arrays given inline pass unchanged.
+fn pairs_from_file(params: &mut Map<String, Value>) -> Result<(), Failure> {
+    let Some(Value::String(path)) = params.get("pairs") else { return Ok(()) };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::usage(format!("error[io]: cannot read --pairs {path}: {e}")))?;
+    let doc: Value = serde_json::from_str(&text)
+        .map_err(|e| Failure::usage(format!("error[invalid-params]: --pairs {path}: {e}")))?;
+    let pairs = match doc {
+        Value::Object(mut m) if m.contains_key("pairs") => m.remove("pairs").unwrap_or(Value::Null),
+        v @ Value::Array(_) => v,
+        _ => {
+            return Err(Failure::usage(format!(
+                "error[invalid-params]: --pairs {path}: expected {{\"pairs\": [...]}} or an array"
+            )))
+        }
+    };
+    params.insert("pairs".into(), pairs);
+    Ok(())
 }

@@ -134,8 +134,22 @@ pub fn execute(
     let mut input_info = Vec::with_capacity(inputs.len());
     for (i, input) in inputs.into_iter().enumerate() {
         progress.check()?;
-        let loaded = read_one(&input, limits)?;
-        if kind == Kind::Core(JobKind::Fit) && i == 1 {
+        let is_fit_curves = kind == Kind::Core(JobKind::Fit) && i == 1;
+        // Fit's curve network may also come as JSON `{"polylines": …}` (issue 5); meshes never do.
+        let json_curves =
+            if is_fit_curves { meshwork_core::fit::curves::polylines_from_json(&input.bytes) } else { None };
+        let (loaded, format) = match json_curves {
+            Some(mesh) => {
+                let mesh = mesh?;
+                (io::Loaded { mesh, format: io::Format::Obj, warnings: Vec::new() }, json!("polylines-json"))
+            }
+            None => {
+                let l = read_one(&input, limits)?;
+                let f = json!(l.format);
+                (l, f)
+            }
+        };
+        if is_fit_curves {
             let points: usize = loaded.mesh.curves.iter().map(Vec::len).sum();
             if points as u64 > limits.max_curve_points {
                 return Err(Error::TooLarge {
@@ -146,7 +160,7 @@ pub fn execute(
             }
         }
         input_info.push(json!({
-            "format": loaded.format,
+            "format": format,
             "bytes": input.bytes.len(),
             "vertices": loaded.mesh.vertex_count(),
             "faces": loaded.mesh.face_count(),
@@ -184,7 +198,12 @@ fn read_one(input: &Input, limits: &Limits) -> Result<io::Loaded, Error> {
 }
 
 /// Runs the job, turning a panic into an internal error for this job only.
-fn run_caught(kind: Kind, meshes: Vec<Mesh>, params: Map<String, Value>, progress: &Progress) -> Result<Output, Error> {
+fn run_caught(
+    kind: Kind,
+    meshes: Vec<Mesh>,
+    params: Map<String, Value>,
+    progress: &Progress,
+) -> Result<Output, Error> {
     let result = catch_unwind(AssertUnwindSafe(|| match kind {
         Kind::Core(k) => job::run(k, meshes, Value::Object(params), progress),
         Kind::Sleep => sleep_job(meshes, params, progress),
@@ -215,7 +234,11 @@ impl Default for SleepParams {
     }
 }
 
-fn sleep_job(mut meshes: Vec<Mesh>, params: Map<String, Value>, progress: &Progress) -> Result<Output, Error> {
+fn sleep_job(
+    mut meshes: Vec<Mesh>,
+    params: Map<String, Value>,
+    progress: &Progress,
+) -> Result<Output, Error> {
     let p: SleepParams = job::parse_params(Value::Object(params))?;
     let t = Instant::now();
     progress.stage("sleep")?;
@@ -236,10 +259,7 @@ pub fn encode(output: &Output, format: Format) -> Result<(Vec<u8>, String, Strin
         let ext = a.name.rsplit('.').next().unwrap_or("bin").to_string();
         return Ok((a.bytes.clone(), a.media_type.clone(), ext));
     }
-    let mesh = output
-        .meshes
-        .first()
-        .ok_or_else(|| Error::Internal("the job returned no mesh".into()))?;
+    let mesh = output.meshes.first().ok_or_else(|| Error::Internal("the job returned no mesh".into()))?;
     Ok((io::write(mesh, format)?, format.mime().to_string(), format.extension().to_string()))
 }
 

@@ -25,7 +25,10 @@ fn stderr(o: &Output) -> String {
 /// No panic message or backtrace ever reaches the user.
 fn assert_clean(o: &Output) {
     let e = stderr(o);
-    assert!(!e.contains("panicked") && !e.contains("RUST_BACKTRACE") && !e.contains("stack backtrace"), "{e}");
+    assert!(
+        !e.contains("panicked") && !e.contains("RUST_BACKTRACE") && !e.contains("stack backtrace"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -51,10 +54,21 @@ fn report_file_params_file_and_stdout_output() {
     std::fs::write(&params, "{}").unwrap();
     let input = tmp("t.obj");
     std::fs::write(&input, TETRA_OBJ).unwrap();
-    let o = run(&["convert", input.to_str().unwrap(), "-o", "-", "--format", "obj", "--report",
-        rep.to_str().unwrap(), "--params", params.to_str().unwrap()]);
+    let o = run(&[
+        "convert",
+        input.to_str().unwrap(),
+        "-o",
+        "-",
+        "--format",
+        "obj",
+        "--report",
+        rep.to_str().unwrap(),
+        "--params",
+        params.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let m = read(&o.stdout, &ReadOptions { name_hint: Some("obj".into()), ..Default::default() }).unwrap().mesh;
+    let m =
+        read(&o.stdout, &ReadOptions { name_hint: Some("obj".into()), ..Default::default() }).unwrap().mesh;
     assert_eq!((m.vertex_count(), m.face_count()), (4, 4));
     let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&rep).unwrap()).unwrap();
     assert_eq!(r["faces"], 4);
@@ -77,11 +91,22 @@ fn bad_input_and_params_exit_2_with_kind_and_location() {
     // Unknown job parameter, from a flag: named.
     let o = run(&["convert", good.to_str().unwrap(), "-o", out.to_str().unwrap(), "--bogus-thing", "3"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("error[invalid-params]") && stderr(&o).contains("bogus_thing"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("error[invalid-params]") && stderr(&o).contains("bogus_thing"),
+        "{}",
+        stderr(&o)
+    );
     // Unknown key in a params file.
     let p = tmp("bad-params.json");
     std::fs::write(&p, "{\"weird\": 1}").unwrap();
-    let o = run(&["convert", good.to_str().unwrap(), "-o", out.to_str().unwrap(), "--params", p.to_str().unwrap()]);
+    let o = run(&[
+        "convert",
+        good.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--params",
+        p.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("weird"), "{}", stderr(&o));
     // Missing file, unknown output extension, missing -o, wrong input count.
@@ -123,11 +148,21 @@ fn info_repair_and_smooth_on_shared_meshes() {
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     // shared/meshes/README.md: 2,903 vertices, 5,804 triangles, closed.
-    assert_eq!((v["vertices"].as_u64(), v["faces"].as_u64(), v["closed"].as_bool()), (Some(2903), Some(5804), Some(true)));
+    assert_eq!(
+        (v["vertices"].as_u64(), v["faces"].as_u64(), v["closed"].as_bool()),
+        (Some(2903), Some(5804), Some(true))
+    );
 
     let out = tmp("suzanne-repaired.glb");
     let rep = tmp("suzanne-report.json");
-    let o = run(&["repair", shared_mesh("suzanne.obj").to_str().unwrap(), "-o", out.to_str().unwrap(), "--report", rep.to_str().unwrap()]);
+    let o = run(&[
+        "repair",
+        shared_mesh("suzanne.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(o.stdout.is_empty(), "report went to the file, not stdout");
     let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&rep).unwrap()).unwrap();
@@ -137,14 +172,101 @@ fn info_repair_and_smooth_on_shared_meshes() {
 
     // Flags are the params' names: --method, --iterations, --preserve-volume (alone = true).
     let out = tmp("fandisk-smooth.obj");
-    let o = run(&["smooth", shared_mesh("fandisk.obj").to_str().unwrap(), "-o", out.to_str().unwrap(),
-        "--method", "taubin", "--iterations", "3", "--preserve-volume"]);
+    let o = run(&[
+        "smooth",
+        shared_mesh("fandisk.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "taubin",
+        "--iterations",
+        "3",
+        "--preserve-volume",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(r["volume_change"].is_number() && r["hausdorff"].is_number(), "{r}");
     let m = read(&std::fs::read(&out).unwrap(), &ReadOptions::default()).unwrap().mesh;
     assert_eq!(m.vertex_count(), 6475);
-    let o = run(&["smooth", shared_mesh("fandisk.obj").to_str().unwrap(), "-o", out.to_str().unwrap(), "--method", "nope"]);
+    let o = run(&[
+        "smooth",
+        shared_mesh("fandisk.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "nope",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("method"), "{}", stderr(&o));
+}
+
+/// Issue 5's CLI form: `meshwork fit TEMPLATE CURVES.json --pairs PAIRS.json`, the curves as
+/// `{"polylines": …}` and the pairs file as `{"pairs": …}`. Truth: the curves are the principal
+/// sections of an analytic ellipsoid, so every segment must end up as mesh edges.
+#[test]
+fn fit_takes_polylines_json_and_a_pairs_file() {
+    use meshwork_core::fit::testdata::ellipsoid_sections;
+    use meshwork_core::io::{write, Format};
+    use meshwork_core::shapes::icosphere;
+    const AXES: [f64; 3] = [1.4, 1.15, 0.9];
+
+    let sphere = icosphere(3, 1.0);
+    let template = tmp("fit-template.obj");
+    std::fs::write(&template, write(&sphere, Format::Obj).unwrap()).unwrap();
+
+    let net = ellipsoid_sections(AXES, 10);
+    let polylines: Vec<Vec<[f64; 3]>> =
+        net.curves.iter().map(|c| c.iter().map(|&v| net.positions[v as usize]).collect()).collect();
+    let curves = tmp("fit-curves.json");
+    std::fs::write(&curves, serde_json::to_vec(&serde_json::json!({ "polylines": polylines })).unwrap())
+        .unwrap();
+
+    // The six axis ends of the unit sphere go to the ellipsoid's axis ends.
+    let mut pairs = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0, 1.0] {
+            let mut dir = [0.0; 3];
+            dir[axis] = sign;
+            let v = (0..sphere.positions.len())
+                .min_by(|&i, &j| {
+                    let d = |k: usize| (0..3).map(|c| (sphere.positions[k][c] - dir[c]).powi(2)).sum::<f64>();
+                    d(i).total_cmp(&d(j))
+                })
+                .unwrap();
+            let mut target = [0.0; 3];
+            target[axis] = sign * AXES[axis];
+            pairs.push(serde_json::json!({ "template_vertex": v, "curve_point": target }));
+        }
+    }
+    let pairs_file = tmp("fit-pairs.json");
+    std::fs::write(&pairs_file, serde_json::to_vec(&serde_json::json!({ "pairs": pairs })).unwrap()).unwrap();
+
+    let out = tmp("fit-out.obj");
+    let report = tmp("fit-report.json");
+    let o = run(&[
+        "fit",
+        template.to_str().unwrap(),
+        curves.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--pairs",
+        pairs_file.to_str().unwrap(),
+    ]);
+    assert_clean(&o);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(r["alignment"]["method"], "pairs", "{r}");
+    assert_eq!(r["segments_as_edges"], 1.0, "{r}");
+    assert_eq!(r["inputs"][1]["format"], "polylines-json");
+    let fitted = read(&std::fs::read(&out).unwrap(), &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(fitted.groups.len(), 8, "one group per octant region");
+
+    // A malformed point is named by its JSON path, exit 2, no panic.
+    std::fs::write(&curves, br#"{"polylines": [[[0,0,0],[1,0]]]}"#).unwrap();
+    let o = run(&["fit", template.to_str().unwrap(), curves.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_clean(&o);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("polylines[0][1]"), "{}", stderr(&o));
 }

@@ -88,11 +88,8 @@ impl Server {
         let req = b.body(body.map(<[u8]>::to_vec).unwrap_or_default()).expect("request");
         let mut r = self.agent.run(req).unwrap_or_else(|e| panic!("{method} {uri}: {e}"));
         let status = r.status().as_u16();
-        let headers = r
-            .headers()
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_str().unwrap_or("").to_string()))
-            .collect();
+        let headers =
+            r.headers().iter().map(|(k, v)| (k.to_string(), v.to_str().unwrap_or("").to_string())).collect();
         let body = r.body_mut().with_config().limit(1 << 30).read_to_vec().expect("body");
         Resp { status, headers, body }
     }
@@ -143,7 +140,9 @@ pub fn multipart(parts: &[Part]) -> (String, Vec<u8>) {
     let boundary = "XmeshworkTestBoundaryX";
     let mut body = Vec::new();
     for p in parts {
-        body.extend_from_slice(format!("--{boundary}\r\nContent-Disposition: form-data; name=\"{}\"", p.name).as_bytes());
+        body.extend_from_slice(
+            format!("--{boundary}\r\nContent-Disposition: form-data; name=\"{}\"", p.name).as_bytes(),
+        );
         if let Some(f) = p.filename {
             body.extend_from_slice(format!("; filename=\"{f}\"").as_bytes());
         }
