@@ -11,54 +11,18 @@ use crate::mesh::Point3;
 
 use super::kdtree::KdTree;
 
-/// Eigen-decomposition of a small symmetric matrix (row-major `n×n`) by cyclic Jacobi rotations.
-/// Returns the eigenvalues and the eigenvectors as columns (`vecs[i * n + k]` is component `i` of
-/// vector `k`).
+/// Eigen-decomposition of a small symmetric matrix (row-major `n×n`), as
+/// [`crate::register::symmetric_eigen`] computes it, with the eigenvectors laid out as columns
+/// (`vecs[i * n + k]` is component `i` of vector `k`), the layout the fit code indexes.
 pub fn sym_eigen(a: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut a = a.to_vec();
-    let mut v = vec![0.0; n * n];
-    for i in 0..n {
-        v[i * n + i] = 1.0;
-    }
-    for _sweep in 0..64 {
-        let off: f64 = (0..n).flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j))).map(|(i, j)| a[i * n + j].powi(2)).sum();
-        let diag: f64 = (0..n).map(|i| a[i * n + i].powi(2)).sum();
-        if off <= 1e-30 * diag.max(1e-300) {
-            break;
-        }
-        for p in 0..n {
-            for q in p + 1..n {
-                let apq = a[p * n + q];
-                if apq.abs() < 1e-300 {
-                    continue;
-                }
-                let theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for k in 0..n {
-                    let akp = a[k * n + p];
-                    let akq = a[k * n + q];
-                    a[k * n + p] = c * akp - s * akq;
-                    a[k * n + q] = s * akp + c * akq;
-                }
-                for k in 0..n {
-                    let apk = a[p * n + k];
-                    let aqk = a[q * n + k];
-                    a[p * n + k] = c * apk - s * aqk;
-                    a[q * n + k] = s * apk + c * aqk;
-                }
-                for k in 0..n {
-                    let vkp = v[k * n + p];
-                    let vkq = v[k * n + q];
-                    v[k * n + p] = c * vkp - s * vkq;
-                    v[k * n + q] = s * vkp + c * vkq;
-                }
-            }
+    let (vals, vecs) = crate::register::symmetric_eigen(a, n);
+    let mut cols = vec![0.0; n * n];
+    for (k, v) in vecs.iter().enumerate() {
+        for (i, &c) in v.iter().enumerate() {
+            cols[i * n + k] = c;
         }
     }
-    ((0..n).map(|i| a[i * n + i]).collect(), v)
+    (vals, cols)
 }
 
 /// x ↦ s·R·x + t.
