@@ -124,7 +124,8 @@ fn rbf_peer(c: &Case) {
         let net = meshwork_core::fit::curves::CurveNetwork::from_mesh(&c.curves, 1e-6).unwrap();
         net.points
     };
-    let values: Vec<Point3> = centres.iter().map(|p| [0.1 * p[1].sin(), 0.05 * p[0] * p[2], -0.02 * p[1]]).collect();
+    let values: Vec<Point3> =
+        centres.iter().map(|p| [0.1 * p[1].sin(), 0.05 * p[0] * p[2], -0.02 * p[1]]).collect();
     let points = &c.template.positions;
     let mut best = f64::INFINITY;
     let mut ours = Vec::new();
@@ -135,7 +136,8 @@ fn rbf_peer(c: &Case) {
         best = best.min(t.elapsed().as_secs_f64());
     }
     println!("meshwork rbf: {} centres, {} points: {:.3} s", centres.len(), points.len(), best);
-    let py = std::path::Path::new(&std::env::var("HOME").unwrap_or_default()).join(".cache/meshwork-peers/bin/python");
+    let py = std::path::Path::new(&std::env::var("HOME").unwrap_or_default())
+        .join(".cache/meshwork-peers/bin/python");
     if !py.exists() {
         println!("scipy peer: venv not installed, skipped");
         return;
@@ -173,8 +175,16 @@ print(best)
                 .chunks(8)
                 .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
                 .collect();
-            let diff = ours.iter().flat_map(|p| p.iter()).zip(&theirs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-            println!("scipy rbf: {s:.3} s  (ratio scipy/meshwork {:.2}; max |difference| {diff:.2e})", s / best);
+            let diff = ours
+                .iter()
+                .flat_map(|p| p.iter())
+                .zip(&theirs)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            println!(
+                "scipy rbf: {s:.3} s  (ratio scipy/meshwork {:.2}; max |difference| {diff:.2e})",
+                s / best
+            );
         }
         Err(_) => println!("scipy peer failed: {}", String::from_utf8_lossy(&o.stderr)),
     }

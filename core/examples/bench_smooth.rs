@@ -131,8 +131,10 @@ fn bench(path: &str, reps: usize, bandwidth: f64) {
     let (ms, _) = best(reps, || job(json!({"method": "implicit", "solver": "cholesky", "hausdorff": false})));
     line(name, n, "job_implicit1(cotan,cholesky)", ms);
     let (ms, _) = best(reps, || {
-        job(json!({"method": "implicit", "operator": "uniform", "relative_time_step": false, "time_step": 0.5,
-                   "preserve_volume": true, "hausdorff": false}))
+        job(
+            json!({"method": "implicit", "operator": "uniform", "relative_time_step": false, "time_step": 0.5,
+                   "preserve_volume": true, "hausdorff": false}),
+        )
     });
     line(name, n, "job_implicit1(uniform,volume,auto)", ms);
     // Seed 004's operator (normalised TQLBO), one implicit step, as Blender's modifier does.

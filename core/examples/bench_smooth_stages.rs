@@ -12,6 +12,11 @@ fn main() {
     let p: serde_json::Value = serde_json::from_str(a.get(2).map(String::as_str).unwrap_or("{}")).unwrap();
     for _ in 0..2 {
         let out = run(JobKind::Smooth, vec![m.clone()], p.clone(), &Progress::new()).unwrap();
-        println!("{} total {:.0} solver {}", out.report["stages"], out.report["total_ms"].as_f64().unwrap(), out.report["solver"]);
+        println!(
+            "{} total {:.0} solver {}",
+            out.report["stages"],
+            out.report["total_ms"].as_f64().unwrap(),
+            out.report["solver"]
+        );
     }
 }

@@ -30,13 +30,21 @@ pub fn angle_stats(positions: &[Point3], faces: &Faces) -> AngleStats {
         .with_min_len(4096)
         .map(|t| {
             let p = [positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]];
-            let a = [corner_angle(p[0], p[1], p[2]), corner_angle(p[1], p[2], p[0]), corner_angle(p[2], p[0], p[1])];
+            let a = [
+                corner_angle(p[0], p[1], p[2]),
+                corner_angle(p[1], p[2], p[0]),
+                corner_angle(p[2], p[0], p[1]),
+            ];
             let lo = a[0].min(a[1]).min(a[2]);
             let hi = a[0].max(a[1]).max(a[2]);
             (lo, lo, hi)
         })
         .reduce(|| (f64::INFINITY, 0.0, 0.0), |x, y| (x.0.min(y.0), x.1 + y.1, x.2.max(y.2)));
-    AngleStats { min: mn.to_degrees(), mean_min: (sum / tris.len() as f64).to_degrees(), max: mx.to_degrees() }
+    AngleStats {
+        min: mn.to_degrees(),
+        mean_min: (sum / tris.len() as f64).to_degrees(),
+        max: mx.to_degrees(),
+    }
 }
 
 /// Newell normal of a polygon (twice its vector area).
@@ -98,7 +106,11 @@ pub fn volume_about(positions: &[Point3], faces: &Faces, apex: Point3) -> f64 {
 }
 
 pub fn area(positions: &[Point3], faces: &Faces) -> f64 {
-    (0..faces.len()).into_par_iter().with_min_len(8192).map(|f| 0.5 * norm(face_normal(positions, faces.get(f)))).sum()
+    (0..faces.len())
+        .into_par_iter()
+        .with_min_len(8192)
+        .map(|f| 0.5 * norm(face_normal(positions, faces.get(f))))
+        .sum()
 }
 
 /// Relative signed change (after − before) / |before|, 0 when before is 0.
@@ -144,7 +156,9 @@ mod tests {
     fn equilateral_angles_and_no_flips() {
         let m = crate::shapes::triangle_grid(4, 4, 1.0);
         let a = angle_stats(&m.positions, &m.faces);
-        assert!((a.min - 60.0).abs() < 1e-9 && (a.mean_min - 60.0).abs() < 1e-9 && (a.max - 60.0).abs() < 1e-9);
+        assert!(
+            (a.min - 60.0).abs() < 1e-9 && (a.mean_min - 60.0).abs() < 1e-9 && (a.max - 60.0).abs() < 1e-9
+        );
         assert_eq!(flipped_faces(&m.positions, &m.positions, &m.faces), 0);
         let mut q = m.positions.clone();
         for p in &mut q {

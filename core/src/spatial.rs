@@ -76,7 +76,13 @@ impl Bvh {
                 continue;
             }
             let ext = sub(cmax, cmin);
-            let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] { 0 } else if ext[1] >= ext[2] { 1 } else { 2 };
+            let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+                0
+            } else if ext[1] >= ext[2] {
+                1
+            } else {
+                2
+            };
             let mid = (lo + hi) / 2;
             order[lo..hi].select_nth_unstable_by(mid - lo, |a, b| {
                 centroids[*a as usize][axis].total_cmp(&centroids[*b as usize][axis])
@@ -198,7 +204,13 @@ pub fn closest_on_triangle(p: Point3, t: &[Point3; 3]) -> Point3 {
         let da = dot(ap, ap);
         let db = dot(bp, bp);
         let dc = dot(cp, cp);
-        return if da <= db && da <= dc { a } else if db <= dc { b } else { c };
+        return if da <= db && da <= dc {
+            a
+        } else if db <= dc {
+            b
+        } else {
+            c
+        };
     }
     let v = vb / denom;
     let w = vc / denom;

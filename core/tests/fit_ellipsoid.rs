@@ -3,8 +3,8 @@
 
 use meshwork_core::fit::testdata::{ellipsoid_distance, ellipsoid_sections};
 use meshwork_core::fit::{run, Alignment, FitPair, FitParams};
-use meshwork_core::geometry::{dist, dot, triangle_cross};
 use meshwork_core::geometry::signed_volume;
+use meshwork_core::geometry::{dist, dot, triangle_cross};
 use meshwork_core::shapes::icosphere;
 use meshwork_core::Progress;
 
@@ -29,7 +29,8 @@ fn check(out: &meshwork_core::Output) -> (f64, f64) {
         .faces
         .iter()
         .filter(|f| {
-            let (a, b, c) = (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
+            let (a, b, c) =
+                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
             let n = triangle_cross(a, b, c);
             let g = [
                 (a[0] + b[0] + c[0]) / AXES[0].powi(2),
@@ -75,14 +76,26 @@ fn pairs_and_automatic_alignment_bring_a_far_template_in() {
         *p = [0.6 * q[0] + 3.0, 0.6 * q[1] - 1.0, 0.6 * q[2] + 2.0];
     }
     // Pairs: the template vertices nearest to the moved axis points ↔ the ellipsoid's axis points.
-    let axis_pts: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let axis_pts: [[f64; 3]; 6] = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
     let pairs = axis_pts
         .iter()
         .map(|a| {
             let q = [c * a[0] - s * a[1], s * a[0] + c * a[1], a[2]];
             let moved = [0.6 * q[0] + 3.0, 0.6 * q[1] - 1.0, 0.6 * q[2] + 2.0];
-            let v = (0..t.positions.len()).min_by(|&i, &j| dist(t.positions[i], moved).total_cmp(&dist(t.positions[j], moved))).unwrap();
-            FitPair { template_vertex: v as u32, curve_point: [a[0] * AXES[0], a[1] * AXES[1], a[2] * AXES[2]] }
+            let v = (0..t.positions.len())
+                .min_by(|&i, &j| dist(t.positions[i], moved).total_cmp(&dist(t.positions[j], moved)))
+                .unwrap();
+            FitPair {
+                template_vertex: v as u32,
+                curve_point: [a[0] * AXES[0], a[1] * AXES[1], a[2] * AXES[2]],
+            }
         })
         .collect();
     let out = fit(t.clone(), &FitParams { pairs, ..Default::default() });

@@ -50,15 +50,18 @@ fn pairs_pointing_at_missing_or_repeated_vertices() {
     let (field, msg) = params_err(fit(t.clone(), c.clone(), &p).unwrap_err());
     assert_eq!(field, "pairs[0].template_vertex");
     assert!(msg.contains("99999"), "{msg}");
-    let p = FitParams { pairs: vec![pair(3, [1.4, 0.0, 0.0]), pair(3, [0.0, 1.15, 0.0])], ..Default::default() };
+    let p =
+        FitParams { pairs: vec![pair(3, [1.4, 0.0, 0.0]), pair(3, [0.0, 1.15, 0.0])], ..Default::default() };
     let (field, msg) = params_err(fit(t.clone(), c.clone(), &p).unwrap_err());
     assert_eq!(field, "pairs[1].template_vertex");
     assert!(msg.contains("pairs[0]"), "{msg}");
-    let p = FitParams { pairs: vec![pair(1, [1.4, 0.0, 0.0]), pair(2, [1.4, 0.0, 0.01])], ..Default::default() };
+    let p =
+        FitParams { pairs: vec![pair(1, [1.4, 0.0, 0.0]), pair(2, [1.4, 0.0, 0.01])], ..Default::default() };
     let (field, _) = params_err(fit(t.clone(), c.clone(), &p).unwrap_err());
     assert_eq!(field, "pairs[1].curve_point");
     // Fewer than 4 pairs, and 4 coplanar ones.
-    let p = FitParams { pairs: vec![pair(1, [1.4, 0.0, 0.0]), pair(2, [0.0, 1.15, 0.0])], ..Default::default() };
+    let p =
+        FitParams { pairs: vec![pair(1, [1.4, 0.0, 0.0]), pair(2, [0.0, 1.15, 0.0])], ..Default::default() };
     let (field, msg) = params_err(fit(t.clone(), c.clone(), &p).unwrap_err());
     assert_eq!(field, "pairs");
     assert!(msg.contains("at least 4"), "{msg}");
@@ -115,8 +118,10 @@ fn unknown_and_out_of_range_params_are_named() {
     let inputs = || vec![icosphere(1, 1.0), ellipsoid_sections(AXES, 2)];
     let e = job::run(JobKind::Fit, inputs(), serde_json::json!({"snap": 0.2}), &Progress::new()).unwrap_err();
     assert_eq!(params_err(e).0, "snap");
-    let e = job::run(JobKind::Fit, inputs(), serde_json::json!({"snap_fraction": 0.9}), &Progress::new()).unwrap_err();
+    let e = job::run(JobKind::Fit, inputs(), serde_json::json!({"snap_fraction": 0.9}), &Progress::new())
+        .unwrap_err();
     assert_eq!(params_err(e).0, "snap_fraction");
-    let e = job::run(JobKind::Fit, inputs(), serde_json::json!({"kernel": "gaussian"}), &Progress::new()).unwrap_err();
+    let e = job::run(JobKind::Fit, inputs(), serde_json::json!({"kernel": "gaussian"}), &Progress::new())
+        .unwrap_err();
     assert!(params_err(e).1.contains("gaussian"));
 }

@@ -24,7 +24,8 @@ fn homer() -> Mesh {
 
 /// Horizontal slices and two vertical ones (offsets chosen off the vertex coordinates).
 fn planes() -> Vec<(Point3, f64)> {
-    let mut p: Vec<(Point3, f64)> = [0.3013, 0.4517, 0.6021, 0.7519, 0.9011].iter().map(|&y| ([0.0, 1.0, 0.0], y)).collect();
+    let mut p: Vec<(Point3, f64)> =
+        [0.3013, 0.4517, 0.6021, 0.7519, 0.9011].iter().map(|&y| ([0.0, 1.0, 0.0], y)).collect();
     p.push(([1.0, 0.0, 0.0], 0.4987));
     p.push(([0.0, 0.0, 1.0], 0.4919));
     p
@@ -47,7 +48,11 @@ fn expected_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
         .iter()
         .map(|t| {
             let c: Vec<Option<u32>> = t.iter().map(|&v| side(fine.positions[v as usize])).collect();
-            if c[0] == c[1] && c[1] == c[2] { c[0] } else { None }
+            if c[0] == c[1] && c[1] == c[2] {
+                c[0]
+            } else {
+                None
+            }
         })
         .collect();
     let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
@@ -131,19 +136,30 @@ fn homer_fits_sections_of_its_bent_self() {
     let mean = devs.iter().sum::<f64>() / devs.len() as f64;
     let p99 = devs[devs.len() * 99 / 100];
     let max = *devs.last().unwrap();
-    eprintln!("expected regions {expected}; deviation / diag: mean {:.2e} p99 {:.2e} max {:.2e}", mean / diag, p99 / diag, max / diag);
+    eprintln!(
+        "expected regions {expected}; deviation / diag: mean {:.2e} p99 {:.2e} max {:.2e}",
+        mean / diag,
+        p99 / diag,
+        max / diag
+    );
 
     // Faces flipped against the truth: output normal vs the truth normal nearest to it.
     let flipped = m
         .faces
         .iter()
         .filter(|f| {
-            let (a, b, c) = (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
-            let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
+            let (a, b, c) =
+                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
+            let centroid =
+                [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
             let (v, _) = tree.nearest(centroid).unwrap();
             let tn = vf[v as usize].iter().fold([0.0; 3], |acc, &g| {
                 let t = truth_tris[g as usize];
-                let n = triangle_cross(truth_pos[t[0] as usize], truth_pos[t[1] as usize], truth_pos[t[2] as usize]);
+                let n = triangle_cross(
+                    truth_pos[t[0] as usize],
+                    truth_pos[t[1] as usize],
+                    truth_pos[t[2] as usize],
+                );
                 [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
             });
             dot(triangle_cross(a, b, c), tn) < 0.0

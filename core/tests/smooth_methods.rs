@@ -41,7 +41,8 @@ fn sphere_shrinks_under_mcf_at_the_predicted_rate() {
     // Continuous MCF: dR/dt = −2/R. Backward Euler with step h: R₊ = (R + √(R² − 8h))/2.
     let m = icosphere(4, 1.0);
     let h = 0.01;
-    let out = smooth(&m, json!({"method": "mcf", "iterations": 5, "time_step": h, "relative_time_step": false}));
+    let out =
+        smooth(&m, json!({"method": "mcf", "iterations": 5, "time_step": h, "relative_time_step": false}));
     let mut r = radii(&m).0;
     for _ in 0..5 {
         r = (r + (r * r - 8.0 * h).sqrt()) / 2.0;
@@ -89,7 +90,8 @@ fn plane_stays_flat() {
 fn implicit_with_volume_preservation_keeps_volume_to_1e9() {
     let m = noisy_sphere(3, 0.05);
     let v0 = signed_volume(&m.positions, &m.faces);
-    let out = smooth(&m, json!({"method": "implicit", "time_step": 5.0, "iterations": 3, "preserve_volume": true}));
+    let out =
+        smooth(&m, json!({"method": "implicit", "time_step": 5.0, "iterations": 3, "preserve_volume": true}));
     let v1 = signed_volume(&out.meshes[0].positions, &m.faces);
     assert!(((v1 - v0) / v0).abs() < 1e-9, "{}", (v1 - v0) / v0);
     // Without preservation the same flow loses volume (the test can fail).
@@ -231,7 +233,8 @@ fn a_bunny_scaled_by_1e_minus_3_smooths_exactly_like_the_original() {
         let a = smooth(&m, p.clone());
         let b = smooth(&small, p.clone());
         // Only the 1,113 vertices no face uses are locked, at both scales.
-        let unused = m.vertex_count() - m.faces.indices().iter().collect::<std::collections::HashSet<_>>().len();
+        let unused =
+            m.vertex_count() - m.faces.indices().iter().collect::<std::collections::HashSet<_>>().len();
         assert_eq!(b.report["locked_vertices"], unused);
         assert_eq!(a.report["locked_vertices"], unused);
         let moved = a.report["mean_displacement"].as_f64().unwrap();
@@ -277,7 +280,8 @@ fn random_quad_to_triangle_conversion_gives_nearly_the_same_result() {
     let a = smooth(&noisy, p.clone());
     let b = smooth(&mixed, p);
     let (xa, xb) = (&a.meshes[0].positions, &b.meshes[0].positions);
-    let moved: f64 = xa.iter().zip(&noisy.positions).map(|(p, q)| norm(sub(*p, *q))).sum::<f64>() / xa.len() as f64;
+    let moved: f64 =
+        xa.iter().zip(&noisy.positions).map(|(p, q)| norm(sub(*p, *q))).sum::<f64>() / xa.len() as f64;
     let diff: f64 = xa.iter().zip(xb).map(|(p, q)| norm(sub(*p, *q))).sum::<f64>() / xa.len() as f64;
     assert!(diff < 0.25 * moved, "difference {diff} vs displacement {moved}");
 }
@@ -336,8 +340,12 @@ fn tangential_flow_improves_triangles_and_stays_on_the_surface() {
 #[test]
 fn solvers_agree() {
     let m = noisy_sphere(4, 0.03);
-    let a = smooth(&m, json!({"method": "implicit", "solver": "cholesky", "time_step": 3.0, "iterations": 2}));
-    let b = smooth(&m, json!({"method": "implicit", "solver": "cg", "time_step": 3.0, "iterations": 2, "cg_tolerance": 1e-12}));
+    let a =
+        smooth(&m, json!({"method": "implicit", "solver": "cholesky", "time_step": 3.0, "iterations": 2}));
+    let b = smooth(
+        &m,
+        json!({"method": "implicit", "solver": "cg", "time_step": 3.0, "iterations": 2, "cg_tolerance": 1e-12}),
+    );
     assert_eq!(a.report["solver"]["kind"], "cholesky");
     assert_eq!(b.report["solver"]["kind"], "cg");
     assert!(a.report["solver"]["factor_nnz"].as_u64().unwrap() > 0);

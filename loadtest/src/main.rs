@@ -83,26 +83,35 @@ struct Tally {
 fn main() {
     match Cli::parse().cmd {
         Cmd::Http { url, job, file, content_type, query, concurrency, duration, server_pid, api_key } => {
-            let body = Arc::new(std::fs::read(&file).unwrap_or_else(|e| die(&format!("{}: {e}", file.display()))));
+            let body =
+                Arc::new(std::fs::read(&file).unwrap_or_else(|e| die(&format!("{}: {e}", file.display()))));
             let ctype = content_type.unwrap_or_else(|| {
                 meshwork_core::io::Format::from_name(&file.display().to_string())
                     .map_or("application/octet-stream".into(), |f| f.mime().to_string())
             });
             let target = format!("{url}/v1/{job}{}{query}", if query.is_empty() { "" } else { "?" });
-            run_http(&target, body, &ctype, concurrency, Duration::from_secs_f64(duration), server_pid, api_key);
+            run_http(
+                &target,
+                body,
+                &ctype,
+                concurrency,
+                Duration::from_secs_f64(duration),
+                server_pid,
+                api_key,
+            );
         }
         Cmd::Inprocess { job, file, params, repeat } => run_inprocess(&job, &file, &params, repeat),
         Cmd::GenTorus { nu, nv, output } => {
             let mesh = meshwork_core::shapes::torus(nu, nv, 1.0, 0.3, false);
             let name = output.display().to_string();
-            let format = meshwork_core::io::Format::from_name(&name).unwrap_or_else(|| die("unknown extension"));
+            let format =
+                meshwork_core::io::Format::from_name(&name).unwrap_or_else(|| die("unknown extension"));
             let bytes = meshwork_core::io::write(&mesh, format).unwrap_or_else(|e| die(&e.to_string()));
             std::fs::write(&output, bytes).unwrap_or_else(|e| die(&e.to_string()));
             println!("{name}: {} vertices, {} faces", mesh.vertex_count(), mesh.face_count());
         }
     }
 }
-
 
 fn die(msg: &str) -> ! {
     eprintln!("loadtest: {msg}");
@@ -173,9 +182,19 @@ fn run_http(
     println!("  503 busy      {}  (all with Retry-After: {})", all.busy_503, all.bad_503 == 0);
     println!("  other status  {}  {:?}", all.other.len(), summarize(&all.other));
     println!("transport errs  {}", all.transport);
-    println!("latency ms      p50 {:.2}  p95 {:.2}  p99 {:.2}  max {:.2}", pct(50.0), pct(95.0), pct(99.0), pct(100.0));
+    println!(
+        "latency ms      p50 {:.2}  p95 {:.2}  p99 {:.2}  max {:.2}",
+        pct(50.0),
+        pct(95.0),
+        pct(99.0),
+        pct(100.0)
+    );
     if let (Some(c0), Some(c1)) = (cpu0, server_pid.and_then(|p| cpu_seconds(&p.to_string()))) {
-        println!("server CPU      {:.2} s, {:.2} ms per answered request", c1 - c0, (c1 - c0) * 1e3 / n.max(1) as f64);
+        println!(
+            "server CPU      {:.2} s, {:.2} ms per answered request",
+            c1 - c0,
+            (c1 - c0) * 1e3 / n.max(1) as f64
+        );
     }
     if let Some(s) = sampler {
         if let Ok((peak, samples, hwm)) = s.join() {
@@ -260,14 +279,16 @@ fn run_inprocess(job: &str, file: &PathBuf, params: &str, repeat: usize) {
     use meshwork_core::io::{self, Format, ReadOptions};
     use meshwork_core::job::{self, JobKind, Progress};
     let kind = JobKind::parse(job).unwrap_or_else(|| die(&format!("unknown job {job}")));
-    let params: serde_json::Value = serde_json::from_str(params).unwrap_or_else(|e| die(&format!("params: {e}")));
+    let params: serde_json::Value =
+        serde_json::from_str(params).unwrap_or_else(|e| die(&format!("params: {e}")));
     let bytes = std::fs::read(file).unwrap_or_else(|e| die(&format!("{}: {e}", file.display())));
     let mut times = Vec::new();
     let cpu0 = cpu_seconds("self");
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
         let mesh = io::read(&bytes, &ReadOptions::default()).unwrap_or_else(|e| die(&e.to_string())).mesh;
-        let out = job::run(kind, vec![mesh], params.clone(), &Progress::new()).unwrap_or_else(|e| die(&e.to_string()));
+        let out = job::run(kind, vec![mesh], params.clone(), &Progress::new())
+            .unwrap_or_else(|e| die(&e.to_string()));
         if kind.returns_mesh() {
             let _ = io::write(&out.meshes[0], Format::Glb).unwrap_or_else(|e| die(&e.to_string()));
         }
@@ -277,6 +298,11 @@ fn run_inprocess(job: &str, file: &PathBuf, params: &str, repeat: usize) {
         println!("in-process CPU: {:.2} ms per run", (c1 - c0) * 1e3 / times.len() as f64);
     }
     times.sort_by(f64::total_cmp);
-    println!("in-process {job} on {}: {} runs, median {:.1} ms, min {:.1} ms", file.display(), times.len(),
-        times[times.len() / 2], times[0]);
+    println!(
+        "in-process {job} on {}: {} runs, median {:.1} ms, min {:.1} ms",
+        file.display(),
+        times.len(),
+        times[times.len() / 2],
+        times[0]
+    );
 }

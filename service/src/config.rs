@@ -93,9 +93,8 @@ impl Config {
             let file: toml::Table = text.parse().map_err(|e| format!("{}: {e}", path.display()))?;
             overlay(&mut table, file);
         }
-        let mut c: Config = toml::Value::Table(table)
-            .try_into()
-            .map_err(|e| format!("configuration: {e}"))?;
+        let mut c: Config =
+            toml::Value::Table(table).try_into().map_err(|e| format!("configuration: {e}"))?;
         c.apply(args)?;
         Ok(c)
     }
@@ -127,9 +126,11 @@ impl Config {
         if self.workers == 0 {
             self.workers = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
         }
-        for (name, v) in [("job_timeout_secs", self.job_timeout_secs), ("result_ttl_secs", self.result_ttl_secs),
-            ("shutdown_grace_secs", self.shutdown_grace_secs)]
-        {
+        for (name, v) in [
+            ("job_timeout_secs", self.job_timeout_secs),
+            ("result_ttl_secs", self.result_ttl_secs),
+            ("shutdown_grace_secs", self.shutdown_grace_secs),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} must be a non-negative number of seconds, got {v}"));
             }
@@ -179,7 +180,8 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let f = dir.join("c.toml");
         std::fs::write(&f, "queue = 3\nworkers = 2\n[limits]\nmax_frames = 7\n").unwrap();
-        let args = ServeArgs { config: Some(f.clone()), workers: Some(5), port: Some(0), ..Default::default() };
+        let args =
+            ServeArgs { config: Some(f.clone()), workers: Some(5), port: Some(0), ..Default::default() };
         let c = Config::load(&args).unwrap();
         assert_eq!((c.queue, c.workers, c.limits.max_frames), (3, 5, 7));
         assert_eq!(c.limits.max_faces, 10_000_000, "untouched keys keep their defaults");

@@ -84,8 +84,22 @@ mod tests {
     #[test]
     fn unknown_flags_become_snake_case_params() {
         let (clap, p) = split_cli_args(
-            &s(&["in.obj", "-o", "out.glb", "--method", "taubin", "--time-step=0.5", "--lambda", "-0.25",
-                "--preserve-volume", "--axis-mask", "[1,0,1]", "--report", "r.json", "--flag"]),
+            &s(&[
+                "in.obj",
+                "-o",
+                "out.glb",
+                "--method",
+                "taubin",
+                "--time-step=0.5",
+                "--lambda",
+                "-0.25",
+                "--preserve-volume",
+                "--axis-mask",
+                "[1,0,1]",
+                "--report",
+                "r.json",
+                "--flag",
+            ]),
             &["-o", "--output", "--report"],
             &["--quiet"],
         );

@@ -9,7 +9,9 @@ use common::*;
 use meshwork_core::io::{read, ReadOptions};
 
 fn read_obj(bytes: &[u8]) -> meshwork_core::Mesh {
-    read(bytes, &ReadOptions { name_hint: Some("x.obj".into()), ..Default::default() }).expect("readable output").mesh
+    read(bytes, &ReadOptions { name_hint: Some("x.obj".into()), ..Default::default() })
+        .expect("readable output")
+        .mesh
 }
 
 #[test]
@@ -64,7 +66,12 @@ fn sync_convert_raw_body_and_multipart_with_inline_report() {
     // Multipart in, Accept picks OBJ, report=inline gives multipart/mixed (report, then mesh).
     let woody = mesh_bytes("woody.obj");
     let (ct, body) = multipart(&[file_part("mesh", "woody.obj", &woody), json_part("params", "{}")]);
-    let r = s.req("POST", "/v1/convert?report=inline", &[("content-type", &ct), ("accept", "model/obj")], Some(&body));
+    let r = s.req(
+        "POST",
+        "/v1/convert?report=inline",
+        &[("content-type", &ct), ("accept", "model/obj")],
+        Some(&body),
+    );
     assert_eq!(r.status, 200, "{}", r.text());
     let parts = split_mixed(r.header("content-type").unwrap(), &r.body);
     assert_eq!(parts.len(), 2);
@@ -86,19 +93,27 @@ fn bad_input_is_problem_json_naming_where() {
     let p = s.post("/v1/convert?bogus=1", "model/obj", tetra).problem(422, "invalid-params");
     assert_eq!(p["field"], "bogus");
     let p = s
-        .post_multipart("/v1/convert", &[file_part("mesh", "t.obj", tetra), json_part("params", "{\"weird\": true}")])
+        .post_multipart(
+            "/v1/convert",
+            &[file_part("mesh", "t.obj", tetra), json_part("params", "{\"weird\": true}")],
+        )
         .problem(422, "invalid-params");
     assert_eq!(p["field"], "weird");
     s.post_multipart("/v1/convert", &[file_part("mesh", "t.obj", tetra), json_part("params", "[1")])
         .problem(422, "invalid-params");
     // A face index out of range, on line 3.
-    let p = s.post("/v1/convert?format=obj", "model/obj", b"v 0 0 0\nv 1 0 0\nf 1 2 7\n").problem(422, "invalid-mesh");
+    let p = s
+        .post("/v1/convert?format=obj", "model/obj", b"v 0 0 0\nv 1 0 0\nf 1 2 7\n")
+        .problem(422, "invalid-mesh");
     assert_eq!(p["line"], 3, "{p}");
     // A coordinate that is not a number, on line 2.
-    let p = s.post("/v1/convert?format=obj", "model/obj", b"v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").problem(422, "malformed-input");
+    let p = s
+        .post("/v1/convert?format=obj", "model/obj", b"v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n")
+        .problem(422, "malformed-input");
     assert_eq!((p["line"].as_u64(), p["format"].as_str()), (Some(2), Some("obj")), "{p}");
     // Not a mesh at all.
-    s.post("/v1/convert", "application/octet-stream", &[0xde, 0xad, 0xbe, 0xef, 0, 1, 2, 3]).problem(415, "unsupported-format");
+    s.post("/v1/convert", "application/octet-stream", &[0xde, 0xad, 0xbe, 0xef, 0, 1, 2, 3])
+        .problem(415, "unsupported-format");
     s.post("/v1/convert", "model/obj", b"").problem(400, "bad-request");
     s.post_multipart("/v1/convert", &[file_part("meshh", "t.obj", tetra)]).problem(400, "bad-request");
     // Limits, with the limit named.
@@ -165,8 +180,11 @@ fn async_flow_status_result_report_and_cancel() {
     // Job named in the multipart body.
     let r = s.post_multipart(
         "/v1/jobs?format=obj",
-        &[Part { name: "job", filename: None, content_type: "text/plain", data: b"sleep" },
-          file_part("mesh", "t.obj", tetra), json_part("params", "{\"ms\": 300}")],
+        &[
+            Part { name: "job", filename: None, content_type: "text/plain", data: b"sleep" },
+            file_part("mesh", "t.obj", tetra),
+            json_part("params", "{\"ms\": 300}"),
+        ],
     );
     assert_eq!(r.status, 202, "{}", r.text());
     let loc = r.header("location").unwrap().to_string();
@@ -255,16 +273,36 @@ fn bearer_auth_and_cors() {
     let r = s.post("/v1/convert?format=obj", "model/obj", tetra);
     r.problem(401, "unauthorized");
     assert_eq!(r.header("www-authenticate"), Some("Bearer"));
-    s.req("POST", "/v1/convert?format=obj", &[("content-type", "model/obj"), ("authorization", "Bearer nope")], Some(tetra))
-        .problem(401, "unauthorized");
-    let ok = s.req("POST", "/v1/convert?format=obj", &[("content-type", "model/obj"), ("authorization", "Bearer s3cret")], Some(tetra));
+    s.req(
+        "POST",
+        "/v1/convert?format=obj",
+        &[("content-type", "model/obj"), ("authorization", "Bearer nope")],
+        Some(tetra),
+    )
+    .problem(401, "unauthorized");
+    let ok = s.req(
+        "POST",
+        "/v1/convert?format=obj",
+        &[("content-type", "model/obj"), ("authorization", "Bearer s3cret")],
+        Some(tetra),
+    );
     assert_eq!(ok.status, 200);
     // Operational endpoints stay open.
     assert_eq!(s.get("/healthz").status, 200);
     // CORS preflight from the configured origin.
-    let pre = s.req("OPTIONS", "/v1/smooth", &[("origin", "https://app.example"), ("access-control-request-method", "POST")], None);
+    let pre = s.req(
+        "OPTIONS",
+        "/v1/smooth",
+        &[("origin", "https://app.example"), ("access-control-request-method", "POST")],
+        None,
+    );
     assert_eq!(pre.header("access-control-allow-origin"), Some("https://app.example"));
-    let other = s.req("OPTIONS", "/v1/smooth", &[("origin", "https://evil.example"), ("access-control-request-method", "POST")], None);
+    let other = s.req(
+        "OPTIONS",
+        "/v1/smooth",
+        &[("origin", "https://evil.example"), ("access-control-request-method", "POST")],
+        None,
+    );
     assert_eq!(other.header("access-control-allow-origin"), None);
 }
 
@@ -302,9 +340,14 @@ fn sigterm_finishes_running_job_then_exits() {
 fn every_format_out_and_back_in() {
     let s = Server::start(&[]);
     let woody = mesh_bytes("woody.obj");
-    for (fmt, mime) in [("glb", "model/gltf-binary"), ("gltf", "model/gltf+json"), ("obj", "model/obj"),
-        ("ply", "application/x-ply"), ("stl", "model/stl"), ("off", "application/x-off")]
-    {
+    for (fmt, mime) in [
+        ("glb", "model/gltf-binary"),
+        ("gltf", "model/gltf+json"),
+        ("obj", "model/obj"),
+        ("ply", "application/x-ply"),
+        ("stl", "model/stl"),
+        ("off", "application/x-off"),
+    ] {
         let r = s.post(&format!("/v1/convert?format={fmt}"), "model/obj", &woody);
         assert_eq!(r.status, 200, "{fmt}: {}", r.text());
         assert_eq!(r.header("content-type"), Some(mime));
@@ -330,11 +373,16 @@ fn every_format_out_and_back_in() {
 fn validate_repair_and_smooth_through_http() {
     let s = Server::start(&[]);
     // Validate answers with the report itself. Bunny: one component, 5 holes in the base.
-    let r = s.post_multipart("/v1/validate", &[file_part("mesh", "bunny.obj", &mesh_bytes("stanford-bunny.obj"))]);
+    let r = s
+        .post_multipart("/v1/validate", &[file_part("mesh", "bunny.obj", &mesh_bytes("stanford-bunny.obj"))]);
     assert_eq!(r.status, 200, "{}", r.text());
     assert_eq!(r.header("content-type"), Some("application/json"));
     let v = r.json();
-    assert_eq!((v["faces"].as_u64(), v["boundary_loops"].as_u64(), v["components"].as_u64()), (Some(69451), Some(5), Some(1)), "{v}");
+    assert_eq!(
+        (v["faces"].as_u64(), v["boundary_loops"].as_u64(), v["components"].as_u64()),
+        (Some(69451), Some(5), Some(1)),
+        "{v}"
+    );
     // cow.obj: closed.
     let v = s.post("/v1/validate", "model/obj", &mesh_bytes("cow.obj")).json();
     assert_eq!((v["vertices"].as_u64(), v["closed"].as_bool()), (Some(2903), Some(true)), "{v}");
@@ -383,7 +431,10 @@ fn morph_answers_its_animated_glb_and_refuses_genus_one() {
     }
     let b = obj_of(&e);
     // Asked for OBJ, but morph's result is the animated GLB it builds (its artifact).
-    let r = s.post_multipart("/v1/morph?frames=4&format=obj", &[file_part("mesh", "a.obj", &a), file_part("mesh", "b.obj", &b)]);
+    let r = s.post_multipart(
+        "/v1/morph?frames=4&format=obj",
+        &[file_part("mesh", "a.obj", &a), file_part("mesh", "b.obj", &b)],
+    );
     assert_eq!(r.status, 200, "{}", r.text());
     assert_eq!(r.header("content-type"), Some("model/gltf-binary"));
     assert_eq!(&r.body[..4], b"glTF");
@@ -424,14 +475,25 @@ fn fit_takes_template_and_curves_parts() {
     let params = r#"{"alignment": "none", "coplanar_centres": "augment"}"#;
     // 38 curve points > the limit of 30: refused before the job runs, naming the limit.
     let p = s
-        .post_multipart("/v1/fit", &[file_part("template", "grid.obj", &template), file_part("curves", "c.obj", curves.as_bytes()), json_part("params", params)])
+        .post_multipart(
+            "/v1/fit",
+            &[
+                file_part("template", "grid.obj", &template),
+                file_part("curves", "c.obj", curves.as_bytes()),
+                json_part("params", params),
+            ],
+        )
         .problem(413, "too-large");
     assert!(p["detail"].as_str().unwrap().contains("curve points"), "{p}");
     let s = Server::start(&[]);
     // Parts in the "wrong" order still map by name.
     let r = s.post_multipart(
         "/v1/fit?format=obj&report=inline",
-        &[file_part("curves", "c.obj", curves.as_bytes()), json_part("params", params), file_part("template", "grid.obj", &template)],
+        &[
+            file_part("curves", "c.obj", curves.as_bytes()),
+            json_part("params", params),
+            file_part("template", "grid.obj", &template),
+        ],
     );
     assert_eq!(r.status, 200, "{}", r.text());
     let parts = split_mixed(r.header("content-type").unwrap(), &r.body);

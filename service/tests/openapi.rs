@@ -18,12 +18,16 @@ fn checked_in_openapi_matches_the_code() {
     for job in ["validate", "convert", "repair", "smooth", "fit", "morph"] {
         assert!(doc["paths"][format!("/v1/{job}")]["post"].is_object(), "{job}");
     }
-    for p in ["/v1/jobs", "/v1/jobs/{id}", "/v1/jobs/{id}/result", "/v1/jobs/{id}/report", "/healthz", "/metrics"] {
+    for p in
+        ["/v1/jobs", "/v1/jobs/{id}", "/v1/jobs/{id}/result", "/v1/jobs/{id}/report", "/healthz", "/metrics"]
+    {
         assert!(doc["paths"][p].is_object(), "{p}");
     }
     // Errors are documented with their stable types.
     let types = doc["components"]["schemas"]["Problem"]["properties"]["type"]["enum"].as_array().unwrap();
-    for t in ["/problems/malformed-input", "/problems/queue-full", "/problems/timed-out", "/problems/too-large"] {
+    for t in
+        ["/problems/malformed-input", "/problems/queue-full", "/problems/timed-out", "/problems/too-large"]
+    {
         assert!(types.iter().any(|x| x == t), "{t}");
     }
     let smooth = &doc["paths"]["/v1/smooth"]["post"];

@@ -4,9 +4,9 @@
 //! sign choices are each refined by ICP and the best fit wins. Symmetric templates can still
 //! align in more than one way: pairs are the reliable route (the seed always uses them).
 
+use crate::error::Result;
 use crate::geometry::{add, dot, norm2, scale, sub};
 use crate::job::Progress;
-use crate::error::Result;
 use crate::mesh::Point3;
 
 use super::kdtree::KdTree;
@@ -102,10 +102,22 @@ pub fn fit_similarity(from: &[Point3], to: &[Point3]) -> Similarity {
     let (sxx, sxy, sxz, syx, syy, syz, szx, szy, szz) =
         (s[0][0], s[0][1], s[0][2], s[1][0], s[1][1], s[1][2], s[2][0], s[2][1], s[2][2]);
     let nmat = [
-        sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,
-        syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,
-        szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,
-        sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz,
+        sxx + syy + szz,
+        syz - szy,
+        szx - sxz,
+        sxy - syx,
+        syz - szy,
+        sxx - syy - szz,
+        sxy + syx,
+        szx + sxz,
+        szx - sxz,
+        sxy + syx,
+        -sxx + syy - szz,
+        syz + szy,
+        sxy - syx,
+        szx + sxz,
+        syz + szy,
+        -sxx - syy + szz,
     ];
     let (vals, vecs) = sym_eigen(&nmat, 4);
     let k = (0..4).max_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap_or(0);
@@ -127,12 +139,19 @@ pub fn fit_similarity(from: &[Point3], to: &[Point3]) -> Similarity {
 }
 
 /// PCA start + similarity ICP. Returns the map template → curve space and its final RMS distance.
-pub fn pca_icp(template: &[Point3], curve: &[Point3], iterations: u32, progress: &Progress) -> Result<(Similarity, f64)> {
+pub fn pca_icp(
+    template: &[Point3],
+    curve: &[Point3],
+    iterations: u32,
+    progress: &Progress,
+) -> Result<(Similarity, f64)> {
     let tree = KdTree::new(template);
     let (at, st) = pca(template);
     let (ac, sc) = pca(curve);
     let (mt, mc) = (mean(template), mean(curve));
-    let s0 = ((sc[0] + sc[1] + sc[2]) / curve.len() as f64 / ((st[0] + st[1] + st[2]) / template.len() as f64)).sqrt();
+    let s0 =
+        ((sc[0] + sc[1] + sc[2]) / curve.len() as f64 / ((st[0] + st[1] + st[2]) / template.len() as f64))
+            .sqrt();
     let s0 = if s0.is_finite() && s0 > 0.0 { s0 } else { 1.0 };
     let mut best: Option<(Similarity, f64)> = None;
     for signs in [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]] {
@@ -172,7 +191,10 @@ pub fn pca_icp(template: &[Point3], curve: &[Point3], iterations: u32, progress:
             best = Some((m, rms));
         }
     }
-    Ok(best.unwrap_or((Similarity { r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], s: 1.0, t: [0.0; 3] }, f64::INFINITY)))
+    Ok(best.unwrap_or((
+        Similarity { r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], s: 1.0, t: [0.0; 3] },
+        f64::INFINITY,
+    )))
 }
 
 #[cfg(test)]
@@ -190,8 +212,10 @@ mod tests {
     #[test]
     fn horn_recovers_a_similarity() {
         let (c, s) = (0.3f64.cos(), 0.3f64.sin());
-        let truth = Similarity { r: [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], s: 1.7, t: [1.0, -2.0, 3.0] };
-        let from: Vec<Point3> = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0], [1.0, 1.0, 1.0]];
+        let truth =
+            Similarity { r: [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], s: 1.7, t: [1.0, -2.0, 3.0] };
+        let from: Vec<Point3> =
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0], [1.0, 1.0, 1.0]];
         let to: Vec<Point3> = from.iter().map(|&p| truth.apply(p)).collect();
         let m = fit_similarity(&from, &to);
         for p in [[5.0, 1.0, -2.0], [0.1, 0.2, 0.3]] {

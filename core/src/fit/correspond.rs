@@ -69,7 +69,6 @@ pub fn closest(
         claimed[v as usize] = true;
         vop[p as usize] = v;
     }
-    let distances =
-        (0..n).map(|p| crate::geometry::dist(net.points[p], template[vop[p] as usize])).collect();
+    let distances = (0..n).map(|p| crate::geometry::dist(net.points[p], template[vop[p] as usize])).collect();
     Ok(Correspondence { vertex_of_point: vop, conflicts, distances })
 }

@@ -180,7 +180,9 @@ mod tests {
         assert!(count.values().all(|&c| c == 1));
         let area: f64 = tris
             .iter()
-            .map(|t| crate::geometry::triangle_area(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]))
+            .map(|t| {
+                crate::geometry::triangle_area(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
+            })
             .sum();
         assert!((area - 1.0).abs() < 1e-12);
     }

@@ -25,7 +25,8 @@ pub struct KdTree {
 
 impl KdTree {
     pub fn new(points: &[Point3]) -> Self {
-        let mut t = KdTree { pts: points.to_vec(), idx: (0..points.len() as u32).collect(), nodes: Vec::new() };
+        let mut t =
+            KdTree { pts: points.to_vec(), idx: (0..points.len() as u32).collect(), nodes: Vec::new() };
         if !points.is_empty() {
             t.build(0, points.len());
         }
@@ -49,8 +50,9 @@ impl KdTree {
         let axis = (0..3).max_by(|&a, &b| (mx[a] - mn[a]).total_cmp(&(mx[b] - mn[b]))).unwrap_or(0);
         let mid = (lo + hi) / 2;
         let pts = &self.pts;
-        self.idx[lo..hi]
-            .select_nth_unstable_by(mid - lo, |&a, &b| pts[a as usize][axis].total_cmp(&pts[b as usize][axis]));
+        self.idx[lo..hi].select_nth_unstable_by(mid - lo, |&a, &b| {
+            pts[a as usize][axis].total_cmp(&pts[b as usize][axis])
+        });
         let split = self.pts[self.idx[mid] as usize][axis];
         let left = self.build(lo, mid);
         let right = self.build(mid, hi);

@@ -162,7 +162,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         return Err(Error::params("inputs", "fit takes exactly two meshes: template, curves"));
     };
     let mut stages = Stages::new();
-    let net = stages.run(progress, "curves", || curves::CurveNetwork::from_mesh(&curve_mesh, params.join_tolerance))?;
+    let net = stages
+        .run(progress, "curves", || curves::CurveNetwork::from_mesh(&curve_mesh, params.join_tolerance))?;
     if net.points.len() > params.max_curve_vertices as usize {
         return Err(Error::TooLarge {
             what: "curve vertices (RBF centres)".into(),
@@ -179,9 +180,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let template_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
 
-    let coarse = stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
+    let coarse =
+        stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
 
-    let fine = stages.run(progress, "fine", || fine_fit(&mut pos, &mut tris, &net, &coarse, params, template_diag, progress))?;
+    let fine = stages.run(progress, "fine", || {
+        fine_fit(&mut pos, &mut tris, &net, &coarse, params, template_diag, progress)
+    })?;
 
     let reference_normals = report::vertex_normals(&fine.positions, &tris);
     let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), tris)?;
@@ -195,18 +199,22 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
         }
     }
-    let (region, region_count) = stages.run(progress, "partition", || Ok(partition::regions(&out_tris, &curve_edges)))?;
+    let (region, region_count) =
+        stages.run(progress, "partition", || Ok(partition::regions(&out_tris, &curve_edges)))?;
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
     let mut out_pos = mesh.pos.clone();
     if params.smooth {
-        let fixed: Vec<bool> =
-            (0..out_pos.len() as u32).map(|v| realised.on_curve[v as usize] || mesh.is_boundary_vertex(v)).collect();
+        let fixed: Vec<bool> = (0..out_pos.len() as u32)
+            .map(|v| realised.on_curve[v as usize] || mesh.is_boundary_vertex(v))
+            .collect();
         let settings = smooth::SmoothSettings {
             mcf_iterations: params.mcf_iterations,
             mcf_step: params.mcf_step,
             laplacian_iterations: params.laplacian_iterations,
         };
-        stages.run(progress, "smooth", || smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress))?;
+        stages.run(progress, "smooth", || {
+            smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
+        })?;
     }
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
@@ -290,9 +298,20 @@ fn coarse_alignment(
     if use_pairs {
         let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net)?;
         let centres: Vec<Point3> = fixed.iter().map(|&(_, v)| pos[v as usize]).collect();
-        let values: Vec<Point3> = fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
+        let values: Vec<Point3> =
+            fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
         let name = |i: usize| format!("pairs[{i}] (template vertex {})", params.pairs[i].template_vertex);
-        let f = fit_rbf(pos, tris, centres, values, &fixed.iter().map(|x| x.1).collect::<Vec<_>>(), params, "coarse", "pairs", &name)?;
+        let f = fit_rbf(
+            pos,
+            tris,
+            centres,
+            values,
+            &fixed.iter().map(|x| x.1).collect::<Vec<_>>(),
+            params,
+            "coarse",
+            "pairs",
+            &name,
+        )?;
         let disp = f.eval_many(pos, progress)?;
         for (p, d) in pos.iter_mut().zip(disp) {
             *p = add(*p, d);
@@ -308,13 +327,23 @@ fn coarse_alignment(
         });
     }
     if matches!(params.alignment, Alignment::None) {
-        return Ok(CoarseReport { method: "none", pair_curve_points: vec![], pair_snap_distance_max: 0.0, icp_rms: None });
+        return Ok(CoarseReport {
+            method: "none",
+            pair_curve_points: vec![],
+            pair_snap_distance_max: 0.0,
+            icp_rms: None,
+        });
     }
     let (sim, rms) = align::pca_icp(pos, &net.points, 30, progress)?;
     for p in pos.iter_mut() {
         *p = sim.apply(*p);
     }
-    Ok(CoarseReport { method: "pca_icp", pair_curve_points: vec![], pair_snap_distance_max: 0.0, icp_rms: Some(rms) })
+    Ok(CoarseReport {
+        method: "pca_icp",
+        pair_curve_points: vec![],
+        pair_snap_distance_max: 0.0,
+        icp_rms: Some(rms),
+    })
 }
 
 /// Validates the pairs and snaps each curve point to its nearest curve vertex.
@@ -332,7 +361,8 @@ fn snap_pairs(pairs: &[FitPair], nv: usize, net: &curves::CurveNetwork) -> Resul
         if !p.curve_point.iter().all(|c| c.is_finite()) {
             return Err(Error::params(format!("pairs[{i}].curve_point"), "coordinate is NaN or infinite"));
         }
-        let (cp, d2) = tree.nearest(p.curve_point).ok_or_else(|| Error::Internal("empty curve network".into()))?;
+        let (cp, d2) =
+            tree.nearest(p.curve_point).ok_or_else(|| Error::Internal("empty curve network".into()))?;
         snap_max = snap_max.max(d2.sqrt());
         if let Some(j) = out.iter().position(|&(_, v)| v == p.template_vertex) {
             return Err(Error::params(
@@ -388,14 +418,19 @@ fn fit_rbf(
     match check {
         Ok(()) => {}
         Err(Degenerate::TooFew(n)) => {
-            return Err(Error::params(field, format!("the {stage} RBF needs at least 4 non-coplanar centres, got {n}")))
-        }
-        Err(Degenerate::Duplicate(i, j)) => {
             return Err(Error::params(
                 field,
-                format!("{} and {} are at the same position: duplicate RBF centres make the {stage} system singular", name(i), name(j)),
+                format!("the {stage} RBF needs at least 4 non-coplanar centres, got {n}"),
             ))
         }
+        Err(Degenerate::Duplicate(i, j)) => return Err(Error::params(
+            field,
+            format!(
+                "{} and {} are at the same position: duplicate RBF centres make the {stage} system singular",
+                name(i),
+                name(j)
+            ),
+        )),
         Err(Degenerate::Coplanar(ratio)) => {
             if params.coplanar_centres == CoplanarCentres::Reject {
                 return Err(Error::params(
@@ -409,7 +444,10 @@ fn fit_rbf(
             }
             augment(pos, tris, &mut centres, &mut values, centre_vertices);
             if let Err(d) = rbf::check_centres(&centres) {
-                return Err(Error::params(field, format!("{stage} RBF centres stay degenerate after augmentation: {d:?}")));
+                return Err(Error::params(
+                    field,
+                    format!("{stage} RBF centres stay degenerate after augmentation: {d:?}"),
+                ));
             }
         }
     }
@@ -418,7 +456,13 @@ fn fit_rbf(
 
 /// Adds, for up to 8 spread-out centres, two points offset along the template vertex normal by
 /// ± 10% of the centres' extent, carrying the same displacement (they move rigidly with their base).
-fn augment(pos: &[Point3], tris: &[[u32; 3]], centres: &mut Vec<Point3>, values: &mut Vec<Point3>, centre_vertices: &[u32]) {
+fn augment(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    centres: &mut Vec<Point3>,
+    values: &mut Vec<Point3>,
+    centre_vertices: &[u32],
+) {
     let n = centres.len();
     let h = 0.1 * Aabb::of(centres).map(|b| b.diagonal()).unwrap_or(1.0);
     let mut normal = vec![[0.0; 3]; pos.len()];
@@ -475,12 +519,8 @@ fn fine_fit(
     template_diag: f64,
     progress: &Progress,
 ) -> Result<Fine> {
-    let pair_fixed: Vec<(u32, u32)> = coarse
-        .pair_curve_points
-        .iter()
-        .zip(&params.pairs)
-        .map(|(&p, pr)| (p, pr.template_vertex))
-        .collect();
+    let pair_fixed: Vec<(u32, u32)> =
+        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
     let mut flagged_per_round = Vec::new();
     let mut faces_added = 0;
     let budget = tris.len(); // subdivision may at most double the face count
@@ -504,7 +544,8 @@ fn fine_fit(
         let vop = corr.vertex_of_point.clone();
         let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
         let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
-        let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
+        let name =
+            |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
         let before_aug = centres.len();
         let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
         let augmented = f.centre_count() > before_aug;

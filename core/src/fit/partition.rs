@@ -7,7 +7,10 @@ use std::hash::BuildHasherDefault;
 use super::trimesh::{IntHasher, IntMap};
 
 /// Region id per triangle and the number of regions. `curve_edges` are undirected (min, max).
-pub fn regions(tris: &[[u32; 3]], curve_edges: &HashSet<(u32, u32), BuildHasherDefault<IntHasher>>) -> (Vec<u32>, usize) {
+pub fn regions(
+    tris: &[[u32; 3]],
+    curve_edges: &HashSet<(u32, u32), BuildHasherDefault<IntHasher>>,
+) -> (Vec<u32>, usize) {
     let mut edge_faces: IntMap<(u32, u32), [u32; 2]> = IntMap::default();
     edge_faces.reserve(tris.len() * 3 / 2);
     for (f, t) in tris.iter().enumerate() {

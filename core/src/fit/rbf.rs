@@ -25,7 +25,9 @@ use super::align::sym_eigen;
 use super::kdtree::KdTree;
 
 /// The radial function φ.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize, utoipa::ToSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum Kernel {
     /// φ(r) = r, the biharmonic kernel the seed prefers (linear, global interpolation).
@@ -164,9 +166,14 @@ impl Rbf {
         // Residual guard: an ill-conditioned system shows up here rather than as a silent misfit.
         let r = &a0 * &x - &rhs;
         let vmax = values.iter().flat_map(|v| v.iter()).fold(0.0f64, |m, c| m.max(c.abs())).max(1e-300);
-        let rmax = (0..m).flat_map(|i| (0..3).map(move |k| (i, k))).fold(0.0f64, |acc, (i, k)| acc.max(r[(i, k)].abs()));
+        let rmax = (0..m)
+            .flat_map(|i| (0..3).map(move |k| (i, k)))
+            .fold(0.0f64, |acc, (i, k)| acc.max(r[(i, k)].abs()));
         if !rmax.is_finite() || rmax > 1e-6 * vmax.max(1.0) {
-            return Err(Error::numerical(stage, format!("RBF system is ill-conditioned (residual {rmax:.3e})")));
+            return Err(Error::numerical(
+                stage,
+                format!("RBF system is ill-conditioned (residual {rmax:.3e})"),
+            ));
         }
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
         let mut affine = [[0.0; 3]; 4];
@@ -193,7 +200,11 @@ impl Rbf {
 
     /// The field's value at `p`.
     pub fn eval(&self, p: Point3) -> Point3 {
-        let q = [(p[0] - self.origin[0]) / self.scale, (p[1] - self.origin[1]) / self.scale, (p[2] - self.origin[2]) / self.scale];
+        let q = [
+            (p[0] - self.origin[0]) / self.scale,
+            (p[1] - self.origin[1]) / self.scale,
+            (p[2] - self.origin[2]) / self.scale,
+        ];
         let (sx, sy, sz) = match self.kernel {
             Kernel::Linear => self.radial_sum(q, |r| r),
             Kernel::Cubic => self.radial_sum(q, |r| r * r * r),
@@ -259,7 +270,14 @@ fn lu_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
     let mut perm_inv = vec![0usize; n];
     let par = Par::Seq;
     let mut buf = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()));
-    let (_, p) = factor::lu_in_place(a.as_mut(), &mut perm, &mut perm_inv, par, MemStack::new(&mut buf), Default::default());
+    let (_, p) = factor::lu_in_place(
+        a.as_mut(),
+        &mut perm,
+        &mut perm_inv,
+        par,
+        MemStack::new(&mut buf),
+        Default::default(),
+    );
     let mut buf2 = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, rhs.ncols(), par));
     solve::solve_in_place(a.as_ref(), a.as_ref(), p, rhs.as_mut(), par, MemStack::new(&mut buf2));
     Ok(rhs)
@@ -282,7 +300,8 @@ mod tests {
     fn interpolates_exactly_at_centres() {
         let c = cube_corners();
         // Arbitrary non-affine values (hand-picked numbers).
-        let vals: Vec<Point3> = (0..c.len()).map(|i| [i as f64 * 0.1, (i * i) as f64 * 0.01, -(i as f64)]).collect();
+        let vals: Vec<Point3> =
+            (0..c.len()).map(|i| [i as f64 * 0.1, (i * i) as f64 * 0.01, -(i as f64)]).collect();
         for kernel in [Kernel::Linear, Kernel::Cubic] {
             let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
             for (p, v) in c.iter().zip(&vals) {

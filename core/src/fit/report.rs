@@ -98,7 +98,8 @@ impl Quality {
         reference_normals: &[Point3],
     ) -> Quality {
         let pos = &out.positions;
-        let res: Vec<f64> = (0..net.points.len()).map(|p| dist(pos[vertex_of_point[p] as usize], net.points[p])).collect();
+        let res: Vec<f64> =
+            (0..net.points.len()).map(|p| dist(pos[vertex_of_point[p] as usize], net.points[p])).collect();
         let mut dev = 0.0f64;
         for (si, c) in realised.chains.iter().enumerate() {
             let (a, b) = (net.points[net.segments[si][0] as usize], net.points[net.segments[si][1] as usize]);
@@ -116,7 +117,9 @@ impl Quality {
         let ok = realised
             .chains
             .iter()
-            .filter(|c| c.len() >= 2 && c.windows(2).all(|w| edges.contains_key(&(w[0].min(w[1]), w[0].max(w[1])))))
+            .filter(|c| {
+                c.len() >= 2 && c.windows(2).all(|w| edges.contains_key(&(w[0].min(w[1]), w[0].max(w[1]))))
+            })
             .count();
         let tree = KdTree::new(reference_pos);
         let flipped = tris

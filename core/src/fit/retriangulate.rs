@@ -86,7 +86,11 @@ enum Walk {
     /// Snap this neighbour of the start vertex (no face crossed).
     SnapAtStart(u32),
     /// Faces crossed and the (left, right) edges between them, ending at `end` (w, or a vertex to snap).
-    Strip { faces: Vec<u32>, crossed: Vec<(u32, u32)>, end: u32 },
+    Strip {
+        faces: Vec<u32>,
+        crossed: Vec<(u32, u32)>,
+        end: u32,
+    },
     Fail(FailReason),
 }
 
@@ -122,7 +126,8 @@ pub fn realise(
             stats.already_edges += 1;
             chain.push(w);
         } else {
-            let ok = walk_segment(mesh, u, w, snap_fraction, &mut on_curve, &locked_edges, &mut chain, &mut stats);
+            let ok =
+                walk_segment(mesh, u, w, snap_fraction, &mut on_curve, &locked_edges, &mut chain, &mut stats);
             if ok {
                 stats.walked += 1;
             } else {
@@ -375,8 +380,12 @@ fn retriangulate(mesh: &mut TriMesh, u: u32, end: u32, faces: &[u32], crossed: &
         mesh.remove_face(f);
     }
     let origin = mesh.pos[u as usize];
-    let new = ear_cut(mesh, &left_poly, origin, e1, e2)
-        .and_then(|mut a| ear_cut(mesh, &right_poly, origin, e1, e2).map(|b| { a.extend(b); a }));
+    let new = ear_cut(mesh, &left_poly, origin, e1, e2).and_then(|mut a| {
+        ear_cut(mesh, &right_poly, origin, e1, e2).map(|b| {
+            a.extend(b);
+            a
+        })
+    });
     let mut added = Vec::new();
     let ok = match new {
         Some(tris) if tris.len() == faces.len() => {
@@ -419,7 +428,8 @@ fn ear_cut(mesh: &TriMesh, poly: &[u32], origin: Point3, e1: Point3, e2: Point3)
     let mut idx: Vec<usize> = (0..poly.len()).collect();
     let mut out = Vec::with_capacity(poly.len().saturating_sub(2));
     let mut diagonals: IntMap<(u32, u32), ()> = IntMap::default();
-    let cross2 = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    let cross2 =
+        |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     while idx.len() > 3 {
         let n = idx.len();
         let mut best: Option<(usize, f64)> = None;

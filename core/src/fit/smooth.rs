@@ -83,7 +83,13 @@ fn face_normal(pos: &[Point3], t: [u32; 3]) -> Point3 {
 }
 
 /// Smooths `pos` in place; `fixed[v]` vertices never move.
-pub fn smooth(pos: &mut [Point3], tris: &[[u32; 3]], fixed: &[bool], s: &SmoothSettings, progress: &Progress) -> Result<()> {
+pub fn smooth(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    fixed: &[bool],
+    s: &SmoothSettings,
+    progress: &Progress,
+) -> Result<()> {
     let nv = pos.len();
     let r = rings(nv, tris);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
@@ -142,8 +148,9 @@ pub fn smooth(pos: &mut [Point3], tris: &[[u32; 3]], fixed: &[bool], s: &SmoothS
     }
     // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
     let reference = pos.to_vec();
-    let mut ref_face: Vec<u32> =
-        (0..nv).map(|v| if r.vf_off[v] < r.vf_off[v + 1] { r.vf[r.vf_off[v] as usize] } else { u32::MAX }).collect();
+    let mut ref_face: Vec<u32> = (0..nv)
+        .map(|v| if r.vf_off[v] < r.vf_off[v + 1] { r.vf[r.vf_off[v] as usize] } else { u32::MAX })
+        .collect();
     for it in 0..s.laplacian_iterations {
         progress.fraction((s.mcf_iterations + it) as f64 / total)?;
         let old = pos.to_vec();
@@ -190,7 +197,13 @@ fn closest_by_walk(pos: &[Point3], tris: &[[u32; 3]], r: &Rings, start: u32, p: 
         let w = (d00 * d21 - d01 * d20) / den;
         let u = 1.0 - v - w;
         // Edge k of a face is (t[k], t[k+1]); the edge opposite corner 0 is 1, and so on.
-        let (m, edge) = if u <= v && u <= w { (u, 1) } else if v <= w { (v, 2) } else { (w, 0) };
+        let (m, edge) = if u <= v && u <= w {
+            (u, 1)
+        } else if v <= w {
+            (v, 2)
+        } else {
+            (w, 0)
+        };
         if m >= -1e-12 {
             return (f, add(a, add(scale(v0, v), scale(v1, w))));
         }

@@ -124,7 +124,11 @@ pub fn plane_sections(mesh: &Mesh, planes: &[(Point3, f64)]) -> Mesh {
 /// truth: an anisotropic scale, a bend about the y axis and a shift.
 pub fn bend(p: Point3, size: f64) -> Point3 {
     let (x, y, z) = (p[0] / size, p[1] / size, p[2] / size);
-    [size * (1.1 * x + 0.08 * y * y), size * (0.95 * y + 0.05 * (2.0 * x).sin()), size * (1.05 * z + 0.06 * x * x)]
+    [
+        size * (1.1 * x + 0.08 * y * y),
+        size * (0.95 * y + 0.05 * (2.0 * x).sin()),
+        size * (1.05 * z + 0.06 * x * x),
+    ]
 }
 
 /// Keeps every `k`-th vertex along the runs between network nodes (vertices whose degree is not
@@ -162,14 +166,17 @@ pub fn thin_network(curves: &Mesh, k: usize) -> Mesh {
                 if is_node(cur) || cur == s {
                     break;
                 }
-                let Some(&next) = adj[&cur].iter().find(|&&n| n != prev && !used.contains(&(cur.min(n), cur.max(n)))) else {
+                let Some(&next) =
+                    adj[&cur].iter().find(|&&n| n != prev && !used.contains(&(cur.min(n), cur.max(n))))
+                else {
                     break;
                 };
                 used.insert((cur.min(next), cur.max(next)));
                 (prev, cur) = (cur, next);
             }
             let last = run.len() - 1;
-            let kept: Vec<u32> = run.iter().enumerate().filter(|(i, _)| i % k == 0 || *i == last).map(|(_, &v)| v).collect();
+            let kept: Vec<u32> =
+                run.iter().enumerate().filter(|(i, _)| i % k == 0 || *i == last).map(|(_, &v)| v).collect();
             lines.push(kept);
         }
     }

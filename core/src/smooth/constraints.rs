@@ -30,11 +30,9 @@ fn check_index(field: &str, i: u32, n: usize) -> Result<usize> {
 
 fn group_vertices(mesh: &Mesh, field: &str, names: &[String], mark: &mut [bool]) -> Result<()> {
     for name in names {
-        let id = mesh
-            .groups
-            .iter()
-            .position(|g| g == name)
-            .ok_or_else(|| Error::params(field, format!("no face group named {name:?} (groups: {:?})", mesh.groups)))?;
+        let id = mesh.groups.iter().position(|g| g == name).ok_or_else(|| {
+            Error::params(field, format!("no face group named {name:?} (groups: {:?})", mesh.groups))
+        })?;
         for (f, face) in mesh.faces.iter().enumerate() {
             if mesh.faces.group(f) as usize == id {
                 for &v in face {
@@ -94,7 +92,10 @@ pub fn freedom(
     let n = mesh.vertex_count();
     let mut selected = vec![p.region.is_empty() && p.groups.is_empty() && !require_selection; n];
     if require_selection && p.region.is_empty() && p.groups.is_empty() {
-        return Err(Error::params("region", "fair needs the region to fair: `region` (vertices) or `groups`"));
+        return Err(Error::params(
+            "region",
+            "fair needs the region to fair: `region` (vertices) or `groups`",
+        ));
     }
     for &i in &p.region {
         selected[check_index("region", i, n)?] = true;
@@ -121,7 +122,10 @@ pub fn freedom(
                 return Err(Error::params("weights", format!("{} weights for {n} vertices", w.len())));
             }
             if let Some(i) = w.iter().position(|x| !(x.is_finite() && (0.0..=1.0).contains(x))) {
-                return Err(Error::params("weights", format!("weight of vertex {i} is {}, not in [0, 1]", w[i])));
+                return Err(Error::params(
+                    "weights",
+                    format!("weight of vertex {i} is {}, not in [0, 1]", w[i]),
+                ));
             }
             w.clone()
         }

@@ -432,7 +432,8 @@ fn tangential(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
                 // Umbrella Δ = mean(neighbours) − x = −(U x)_i / deg_i.
                 let d = scale([y[3 * i], y[3 * i + 1], y[3 * i + 2]], -lambda * w[i] / deg[i]);
                 let Some(c) = bvh0.closest(x[i]) else { return x[i] };
-                let n = normalize(crate::metrics::face_normal(&mesh.positions, mesh.faces.get(c.face as usize)));
+                let n =
+                    normalize(crate::metrics::face_normal(&mesh.positions, mesh.faces.get(c.face as usize)));
                 let t = sub(d, scale(n, dot(d, n)));
                 bvh0.closest(add(x[i], t)).map(|c| c.point).unwrap_or(x[i])
             })

@@ -83,7 +83,8 @@ pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Out
     })?;
     let mut ctx = stages.run(progress, "prepare", || {
         let boundary = stencil.boundary_vertices();
-        let free = constraints::freedom(&mesh, params, r.boundary, &boundary, &op.locked, r.method == Method::Fair)?;
+        let free =
+            constraints::freedom(&mesh, params, r.boundary, &boundary, &op.locked, r.method == Method::Fair)?;
         let edge_len = laplacian::mean_edge_length(&stencil, &mesh.positions);
         let center = centroid(&mesh.positions);
         let volume0 = metrics::volume_about(&mesh.positions, &mesh.faces, center);

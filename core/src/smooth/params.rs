@@ -160,7 +160,9 @@ impl SmoothParams {
                 _ => 0.5,
             }),
         )?;
-        if matches!(m, Method::Laplacian | Method::Taubin | Method::Tangential) && !(lambda > 0.0 && lambda <= 1.0) {
+        if matches!(m, Method::Laplacian | Method::Taubin | Method::Tangential)
+            && !(lambda > 0.0 && lambda <= 1.0)
+        {
             return Err(Error::params("lambda", format!("explicit steps need 0 < lambda ≤ 1, got {lambda}")));
         }
         let mu = match (self.mu, self.pass_band) {
@@ -169,7 +171,10 @@ impl SmoothParams {
             (None, pb) => {
                 let kpb = finite("pass_band", pb.unwrap_or(0.1))?;
                 if !(kpb > 0.0 && kpb < 1.0 / lambda) {
-                    return Err(Error::params("pass_band", format!("need 0 < pass_band < 1/lambda, got {kpb}")));
+                    return Err(Error::params(
+                        "pass_band",
+                        format!("need 0 < pass_band < 1/lambda, got {kpb}"),
+                    ));
                 }
                 1.0 / (kpb - 1.0 / lambda)
             }

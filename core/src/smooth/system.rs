@@ -134,14 +134,14 @@ impl System {
         }
         let t = Instant::now();
         let rhs = self.dirichlet.rhs(&self.full, b.as_flattened(), x.as_flattened(), 3);
-        let mut y: Vec<f64> =
-            self.dirichlet.free.iter().flat_map(|&i| x[i as usize]).collect();
+        let mut y: Vec<f64> = self.dirichlet.free.iter().flat_map(|&i| x[i as usize]).collect();
         let mut fallback = false;
         match &self.backend {
             Backend::Cg => {
                 let info = pcg(&self.dirichlet.reduced, &rhs, &mut y, 3, self.tol, CG_MAX_ITER);
                 self.stats.cg_iterations += info.iterations;
-                self.stats.cg_max_relative_residual = self.stats.cg_max_relative_residual.max(info.relative_residual);
+                self.stats.cg_max_relative_residual =
+                    self.stats.cg_max_relative_residual.max(info.relative_residual);
                 fallback = !info.converged;
             }
             Backend::Cholesky(ch) => {

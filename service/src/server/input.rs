@@ -40,7 +40,9 @@ pub fn parse_query(query: Option<&str>) -> Result<QueryOpts, Problem> {
             "report" => match v.as_str() {
                 "inline" => q.report_inline = true,
                 "link" => q.report_inline = false,
-                _ => return Err(Problem::bad_request(format!("report must be `inline` or `link`, got `{v}`"))),
+                _ => {
+                    return Err(Problem::bad_request(format!("report must be `inline` or `link`, got `{v}`")))
+                }
             },
             "job" => q.job = Some(v),
             "params" => q.params = json_object(&v, "the `params` query value")?,
@@ -65,8 +67,13 @@ fn serde_urlencoded_pairs(query: &str) -> Result<Vec<(String, String)>, Problem>
 fn json_object(text: &str, what: &str) -> Result<Map<String, Value>, Problem> {
     match serde_json::from_str::<Value>(text) {
         Ok(Value::Object(m)) => Ok(m),
-        Ok(_) => Err(Problem::new("invalid-params", format!("{what} must be a JSON object")).with("field", "params")),
-        Err(e) => Err(Problem::new("invalid-params", format!("{what} is not JSON: {e}")).with("field", "params")),
+        Ok(_) => {
+            Err(Problem::new("invalid-params", format!("{what} must be a JSON object"))
+                .with("field", "params"))
+        }
+        Err(e) => {
+            Err(Problem::new("invalid-params", format!("{what} is not JSON: {e}")).with("field", "params"))
+        }
     }
 }
 
@@ -80,12 +87,8 @@ pub async fn parse_body(req: Request, q: &QueryOpts, limits: &Limits) -> Result<
             return Err(p);
         }
     }
-    let ctype = req
-        .headers()
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .unwrap_or("")
-        .to_string();
+    let ctype =
+        req.headers().get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).unwrap_or("").to_string();
     let mut parsed = if ctype.to_ascii_lowercase().starts_with("multipart/form-data") {
         parse_multipart(req, limit).await?
     } else {
@@ -190,14 +193,18 @@ async fn parse_multipart(req: Request, limit: u64) -> Result<Parsed, Problem> {
         let ctype = field.content_type().map(str::to_string);
         let data = field.bytes().await.map_err(|e| multipart_error(e, limit))?;
         bytes_in += data.len();
-        let hint = file_name.or_else(|| ctype.as_deref().and_then(Format::from_mime).map(|f| f.extension().into()));
+        let hint =
+            file_name.or_else(|| ctype.as_deref().and_then(Format::from_mime).map(|f| f.extension().into()));
         match name.as_str() {
-            "mesh" | "meshes" | "mesh[]" | "meshes[]" => meshes.push(Input { bytes: data.to_vec(), name_hint: hint }),
+            "mesh" | "meshes" | "mesh[]" | "meshes[]" => {
+                meshes.push(Input { bytes: data.to_vec(), name_hint: hint })
+            }
             "template" => template = Some(Input { bytes: data.to_vec(), name_hint: hint }),
             "curves" => curves = Some(Input { bytes: data.to_vec(), name_hint: hint }),
             "params" => {
-                let text = std::str::from_utf8(&data)
-                    .map_err(|_| Problem::new("invalid-params", "the params part is not UTF-8").with("field", "params"))?;
+                let text = std::str::from_utf8(&data).map_err(|_| {
+                    Problem::new("invalid-params", "the params part is not UTF-8").with("field", "params")
+                })?;
                 params = json_object(text, "the params part")?;
             }
             "job" => job = Some(String::from_utf8_lossy(&data).trim().to_string()),
@@ -233,8 +240,9 @@ fn multipart_error(e: axum::extract::multipart::MultipartError, limit: u64) -> P
 /// can produce was acceptable (406).
 pub fn choose_format(format: Option<&str>, headers: &HeaderMap) -> Result<Format, Problem> {
     if let Some(f) = format {
-        return Format::from_name(f)
-            .ok_or_else(|| Problem::bad_request(format!("unknown format `{f}` (glb, gltf, obj, ply, stl, off)")));
+        return Format::from_name(f).ok_or_else(|| {
+            Problem::bad_request(format!("unknown format `{f}` (glb, gltf, obj, ply, stl, off)"))
+        });
     }
     let Some(accept) = headers.get(header::ACCEPT).and_then(|v| v.to_str().ok()) else {
         return Ok(Format::Glb);
@@ -265,7 +273,10 @@ pub fn choose_format(format: Option<&str>, headers: &HeaderMap) -> Result<Format
             return Ok(f);
         }
     }
-    Err(Problem::new("not-acceptable", format!("cannot produce any of `{accept}`; use model/gltf-binary, model/gltf+json, model/obj, …")))
+    Err(Problem::new(
+        "not-acceptable",
+        format!("cannot produce any of `{accept}`; use model/gltf-binary, model/gltf+json, model/obj, …"),
+    ))
 }
 
 #[cfg(test)]
@@ -275,9 +286,14 @@ mod tests {
 
     #[test]
     fn query_params_use_json_names_and_override_params_json() {
-        let q = parse_query(Some("method=taubin&iterations=5&params=%7B%22iterations%22%3A2%2C%22lambda%22%3A0.5%7D&format=obj"))
-            .unwrap();
-        assert_eq!(Value::Object(q.params), serde_json::json!({"iterations": 5, "lambda": 0.5, "method": "taubin"}));
+        let q = parse_query(Some(
+            "method=taubin&iterations=5&params=%7B%22iterations%22%3A2%2C%22lambda%22%3A0.5%7D&format=obj",
+        ))
+        .unwrap();
+        assert_eq!(
+            Value::Object(q.params),
+            serde_json::json!({"iterations": 5, "lambda": 0.5, "method": "taubin"})
+        );
         assert_eq!(q.format.as_deref(), Some("obj"));
     }
 

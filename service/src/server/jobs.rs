@@ -57,7 +57,10 @@ fn admit(st: &Shared) -> Result<OwnedSemaphorePermit, Problem> {
         metrics::counter!("meshwork_rejected_total", "reason" => "queue_full").increment(1);
         let mut p = Problem::new(
             "queue-full",
-            format!("{} jobs are admitted (running + queued), the configured maximum; retry later", st.cfg.admitted()),
+            format!(
+                "{} jobs are admitted (running + queued), the configured maximum; retry later",
+                st.cfg.admitted()
+            ),
         )
         .with("limit", st.cfg.admitted());
         p.retry_after = Some(1);
@@ -67,8 +70,11 @@ fn admit(st: &Shared) -> Result<OwnedSemaphorePermit, Problem> {
 
 fn kind_of(st: &Shared, name: &str) -> Result<Kind, Problem> {
     Kind::parse(name, st.cfg.debug_jobs).ok_or_else(|| {
-        Problem::new("unknown-job", format!("no job `{name}` (validate, convert, repair, smooth, fit, morph)"))
-            .with("field", "job")
+        Problem::new(
+            "unknown-job",
+            format!("no job `{name}` (validate, convert, repair, smooth, fit, morph)"),
+        )
+        .with("field", "job")
     })
 }
 
@@ -111,8 +117,10 @@ fn launch(
             Ok(_) => "succeeded".to_string(),
             Err(p) => p.kind().to_string(),
         };
-        metrics::counter!("meshwork_jobs_total", "job" => kind.name(), "outcome" => outcome_label).increment(1);
-        metrics::histogram!("meshwork_job_duration_seconds", "job" => kind.name()).record(t.elapsed().as_secs_f64());
+        metrics::counter!("meshwork_jobs_total", "job" => kind.name(), "outcome" => outcome_label)
+            .increment(1);
+        metrics::histogram!("meshwork_job_duration_seconds", "job" => kind.name())
+            .record(t.elapsed().as_secs_f64());
         if keep_result {
             st2.store.finish(&id2, outcome);
         } else {
@@ -175,7 +183,11 @@ async fn sync_inner(st: Shared, job: String, req: Request) -> Result<Response, P
     let (file, report) = match outcome {
         Ok(Ok(x)) => x,
         Ok(Err(p)) => return Err(p.with("job_id", id.as_str())),
-        Err(_) => return Err(Problem::new("internal", "the job ended without an outcome").with("job_id", id.as_str())),
+        Err(_) => {
+            return Err(
+                Problem::new("internal", "the job ended without an outcome").with("job_id", id.as_str())
+            )
+        }
     };
     let mut resp = match file {
         None => Json(report).into_response(),
@@ -198,11 +210,7 @@ async fn refused_early(p: Problem, req: Request) -> Response {
 fn file_response(f: ResultFile, name: &str) -> Response {
     metrics::counter!("meshwork_bytes_out_total").increment(f.bytes.len() as u64);
     let disp = format!("attachment; filename=\"{name}.{}\"", f.extension);
-    (
-        [(header::CONTENT_TYPE, f.media_type), (header::CONTENT_DISPOSITION, disp)],
-        f.bytes,
-    )
-        .into_response()
+    ([(header::CONTENT_TYPE, f.media_type), (header::CONTENT_DISPOSITION, disp)], f.bytes).into_response()
 }
 
 /// `multipart/mixed`: part 1 the JSON report (`name="report"`), part 2 the mesh (`name="mesh"`).
@@ -278,7 +286,10 @@ pub async fn result(State(st): State<Shared>, Path(id): Path<String>) -> Respons
         Ok(f) => {
             metrics::counter!("meshwork_bytes_out_total").increment(f.bytes.len() as u64);
             let disp = format!("attachment; filename=\"{id}.{}\"", f.extension);
-            ([(header::CONTENT_TYPE, f.media_type.clone()), (header::CONTENT_DISPOSITION, disp)], f.bytes.clone())
+            (
+                [(header::CONTENT_TYPE, f.media_type.clone()), (header::CONTENT_DISPOSITION, disp)],
+                f.bytes.clone(),
+            )
                 .into_response()
         }
         Err(p) => p.into_response(),

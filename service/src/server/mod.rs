@@ -1,11 +1,11 @@
 //! `meshwork serve`: the HTTP job service. Requests are admitted through a bounded gate (503 at
 //! once when full), jobs run on a dedicated rayon pool, and every error is problem+json.
 
+mod input;
 pub mod jobs;
 pub mod openapi;
 pub mod problem;
 pub mod store;
-mod input;
 
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -83,7 +83,8 @@ pub fn build_state(cfg: Config) -> Result<Shared, String> {
 
 async fn serve(cfg: Config) -> Result<(), String> {
     let grace = Duration::from_secs_f64(cfg.shutdown_grace_secs);
-    let listener = tokio::net::TcpListener::bind(&cfg.bind).await.map_err(|e| format!("bind {}: {e}", cfg.bind))?;
+    let listener =
+        tokio::net::TcpListener::bind(&cfg.bind).await.map_err(|e| format!("bind {}: {e}", cfg.bind))?;
     let addr: SocketAddr = listener.local_addr().map_err(|e| e.to_string())?;
     let state = build_state(cfg)?;
     let app = router(state.clone());

@@ -25,8 +25,18 @@ Synchronous: `POST /v1/{job}` answers with the result. Asynchronous: `POST /v1/j
         license(name = "MIT OR Apache-2.0")
     ),
     components(schemas(
-        ValidateParams, EmptyParams, RepairParams, SmoothParams, FitParams, MorphParams,
-        Problem, JobStatus, Links, State, JobKind, Format
+        ValidateParams,
+        EmptyParams,
+        RepairParams,
+        SmoothParams,
+        FitParams,
+        MorphParams,
+        Problem,
+        JobStatus,
+        Links,
+        State,
+        JobKind,
+        Format
     ))
 )]
 struct Schemas;
@@ -99,7 +109,8 @@ fn error_responses(kinds: &[&str]) -> Map<String, Value> {
             "content": {"application/problem+json": {"schema": problem_ref()}},
         });
         if status == 503 {
-            resp["headers"] = json!({"Retry-After": {"description": "Seconds to wait", "schema": {"type": "integer"}}});
+            resp["headers"] =
+                json!({"Retry-After": {"description": "Seconds to wait", "schema": {"type": "integer"}}});
         }
         m.insert(status.to_string(), resp);
     }
@@ -107,9 +118,22 @@ fn error_responses(kinds: &[&str]) -> Map<String, Value> {
 }
 
 const JOB_ERRORS: &[&str] = &[
-    "unsupported-format", "malformed-input", "external-reference", "invalid-mesh", "invalid-params", "too-large",
-    "unsupported-topology", "numerical-failure", "timed-out", "internal", "bad-request", "unauthorized",
-    "unknown-job", "not-acceptable", "queue-full", "shutting-down",
+    "unsupported-format",
+    "malformed-input",
+    "external-reference",
+    "invalid-mesh",
+    "invalid-params",
+    "too-large",
+    "unsupported-topology",
+    "numerical-failure",
+    "timed-out",
+    "internal",
+    "bad-request",
+    "unauthorized",
+    "unknown-job",
+    "not-acceptable",
+    "queue-full",
+    "shutting-down",
 ];
 
 fn query(name: &str, description: &str, schema: Value) -> Value {
@@ -140,7 +164,10 @@ fn sync_path(kind: JobKind, schemas: &Map<String, Value>) -> Value {
     // Every params field may also be given as its own query parameter, same name as in JSON.
     if let Some(props) = schemas.get(pschema).and_then(|s| s.get("properties")).and_then(Value::as_object) {
         for (field, s) in props {
-            let d = s.get("description").and_then(Value::as_str).unwrap_or("Job parameter (see the params schema).");
+            let d = s
+                .get("description")
+                .and_then(Value::as_str)
+                .unwrap_or("Job parameter (see the params schema).");
             params.push(query(field, d, s.clone()));
         }
     }
@@ -165,7 +192,8 @@ fn sync_path(kind: JobKind, schemas: &Map<String, Value>) -> Value {
     }
     let ok = if kind.returns_mesh() {
         let mut c = Map::new();
-        let types: Vec<&str> = if kind == JobKind::Morph { vec!["model/gltf-binary"] } else { MESH_TYPES.to_vec() };
+        let types: Vec<&str> =
+            if kind == JobKind::Morph { vec!["model/gltf-binary"] } else { MESH_TYPES.to_vec() };
         for t in types {
             c.insert(t.into(), json!({"schema": binary()}));
         }
@@ -184,7 +212,9 @@ fn sync_path(kind: JobKind, schemas: &Map<String, Value>) -> Value {
     let mut responses = error_responses(JOB_ERRORS);
     responses.insert("200".into(), ok);
     let inputs = match (kind, lo, hi) {
-        (JobKind::Fit, _, _) => "Inputs: `template` and `curves` parts (or two `mesh` parts in that order).".to_string(),
+        (JobKind::Fit, _, _) => {
+            "Inputs: `template` and `curves` parts (or two `mesh` parts in that order).".to_string()
+        }
         (_, 1, 1) => "Input: one `mesh` part, or the mesh as the raw body with its Content-Type.".to_string(),
         _ => format!("Inputs: {lo} to {hi} `mesh` parts, in order."),
     };
@@ -259,7 +289,14 @@ fn async_paths() -> Map<String, Value> {
         c.insert(t.to_string(), json!({"schema": binary()}));
     }
     result_ok.insert("200".into(), json!({"description": "The result file", "content": c}));
-    jobs_errors.extend(["cancelled", "timed-out", "internal", "unsupported-format", "malformed-input", "invalid-params"]);
+    jobs_errors.extend([
+        "cancelled",
+        "timed-out",
+        "internal",
+        "unsupported-format",
+        "malformed-input",
+        "invalid-params",
+    ]);
     p.insert("/v1/jobs/{id}/result".into(), json!({"parameters": [id_param()], "get": {
         "tags": ["jobs"], "operationId": "job_result", "summary": "The result of a succeeded job",
         "description": "409 while queued/running; a failed job answers with its own problem; 410 once expired or evicted.",
@@ -279,14 +316,28 @@ fn ops_paths() -> Map<String, Value> {
             "responses": {"200": {"description": "OK", "content": {ctype: {"schema": schema}}}}}})
     };
     p.insert("/healthz".into(), simple("healthz", "Liveness", "application/json", json!({"type": "object"})));
-    let mut ready = simple("readyz", "Readiness: not shutting down and a job slot is free", "application/json", json!({"type": "object"}));
-    ready["get"]["responses"]["503"] = json!({"description": "Not ready", "content": {"application/json": {"schema": {"type": "object"}}}});
+    let mut ready = simple(
+        "readyz",
+        "Readiness: not shutting down and a job slot is free",
+        "application/json",
+        json!({"type": "object"}),
+    );
+    ready["get"]["responses"]["503"] =
+        json!({"description": "Not ready", "content": {"application/json": {"schema": {"type": "object"}}}});
     p.insert("/readyz".into(), ready);
-    p.insert("/metrics".into(), simple("metrics", "Prometheus metrics", "text/plain", json!({"type": "string"})));
-    p.insert("/openapi.json".into(), simple("openapi", "This document", "application/json", json!({"type": "object"})));
+    p.insert(
+        "/metrics".into(),
+        simple("metrics", "Prometheus metrics", "text/plain", json!({"type": "string"})),
+    );
+    p.insert(
+        "/openapi.json".into(),
+        simple("openapi", "This document", "application/json", json!({"type": "object"})),
+    );
     p.insert("/docs".into(), simple("docs", "API reference page", "text/html", json!({"type": "string"})));
-    let mut prob = simple("problem_type", "Describes a problem type", "application/json", json!({"type": "object"}));
-    prob["parameters"] = json!([{"name": "kind", "in": "path", "required": true, "schema": {"type": "string"}}]);
+    let mut prob =
+        simple("problem_type", "Describes a problem type", "application/json", json!({"type": "object"}));
+    prob["parameters"] =
+        json!([{"name": "kind", "in": "path", "required": true, "schema": {"type": "string"}}]);
     p.insert("/problems/{kind}".into(), prob);
     p
 }

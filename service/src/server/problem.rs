@@ -163,7 +163,10 @@ mod tests {
         let errors = [
             Error::UnsupportedFormat(String::new()),
             Error::malformed("obj", Location::Line(3), "x"),
-            Error::ExternalReference { location: Location::Gltf("buffers[0]".into()), message: String::new() },
+            Error::ExternalReference {
+                location: Location::Gltf("buffers[0]".into()),
+                message: String::new(),
+            },
             Error::InvalidMesh { location: Location::Face(1), message: String::new() },
             Error::params("a", "b"),
             Error::TooLarge { what: "vertices".into(), limit: 1, actual: 2 },

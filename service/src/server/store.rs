@@ -293,9 +293,13 @@ impl Store {
                 Problem::new("conflict", format!("job {id} is still {:?}", r.state).to_lowercase())
                     .with("job_id", id)
             }
-            State::Failed | State::Cancelled => r.problem.clone().unwrap_or_else(|| Problem::new("internal", "")),
+            State::Failed | State::Cancelled => {
+                r.problem.clone().unwrap_or_else(|| Problem::new("internal", ""))
+            }
             // A sync job's result went back in its response and is not kept.
-            State::Succeeded => Problem::not_found(format!("job {id} keeps no {what} (it was returned synchronously)")),
+            State::Succeeded => {
+                Problem::not_found(format!("job {id} keeps no {what} (it was returned synchronously)"))
+            }
         }
     }
 
@@ -304,8 +308,11 @@ impl Store {
         let g = self.lock();
         let r = g.map.get(id).ok_or_else(|| unknown(id))?;
         if r.state.finished() {
-            return Err(Problem::new("conflict", format!("job {id} already finished ({:?})", r.state).to_lowercase())
-                .with("job_id", id));
+            return Err(Problem::new(
+                "conflict",
+                format!("job {id} already finished ({:?})", r.state).to_lowercase(),
+            )
+            .with("job_id", id));
         }
         r.progress.cancel();
         Ok(self.view(id, r))
