@@ -423,14 +423,16 @@ fn fit_rbf(
                 format!("the {stage} RBF needs at least 4 non-coplanar centres, got {n}"),
             ))
         }
-        Err(Degenerate::Duplicate(i, j)) => return Err(Error::params(
-            field,
-            format!(
+        Err(Degenerate::Duplicate(i, j)) => {
+            return Err(Error::params(
+                field,
+                format!(
                 "{} and {} are at the same position: duplicate RBF centres make the {stage} system singular",
                 name(i),
                 name(j)
             ),
-        )),
+            ))
+        }
         Err(Degenerate::Coplanar(ratio)) => {
             if params.coplanar_centres == CoplanarCentres::Reject {
                 return Err(Error::params(
