@@ -1,33 +1,15 @@
 //! Validation reports of the shared real meshes against the counts in ../shared/meshes/README.md
 //! (made by other people with other tools), and against counts derived here from the raw files.
 
-use std::path::PathBuf;
+mod shared_meshes;
 
 use meshwork_core::io::{self, ReadOptions};
 use meshwork_core::mesh::{Faces, Mesh};
 use meshwork_core::shapes;
 use meshwork_core::validate::{analyze, Report};
 
-/// The shared meshes folder; on a machine without it the real-mesh tests say so and pass.
-fn shared(name: &str) -> Option<Vec<u8>> {
-    let dir = std::env::var_os("MESHWORK_MESHES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes"));
-    match std::fs::read(dir.join(name)) {
-        Ok(b) => Some(b),
-        Err(e) => {
-            eprintln!("SKIP {name}: {e} (set MESHWORK_MESHES to the shared meshes folder)");
-            None
-        }
-    }
-}
-
-fn load(name: &str) -> Option<Mesh> {
-    Some(io::read(&shared(name)?, &ReadOptions::default()).expect("readable").mesh)
-}
-
 fn report(name: &str) -> Option<Report> {
-    load(name).map(|m| analyze(&m))
+    shared_meshes::load(name).map(|m| analyze(&m))
 }
 
 #[test]
@@ -74,7 +56,7 @@ fn cow_odd_euler_is_a_non_manifold_vertex() {
 /// components" we do not reproduce: trimesh also reports 3 bodies.)
 #[test]
 fn suzanne_polygons_and_triangulated() {
-    let Some(m) = load("suzanne.obj") else { return };
+    let Some(m) = shared_meshes::load("suzanne.obj") else { return };
     let r = analyze(&m);
     assert_eq!(r.faces, 500);
     assert_eq!(r.face_arity.get("4"), Some(&468));
@@ -134,7 +116,7 @@ pub fn spot_uv_split(bytes: &[u8]) -> Mesh {
 
 #[test]
 fn spot_thirteen_pieces_until_welded() {
-    let Some(bytes) = shared("spot.obj") else { return };
+    let Some(bytes) = shared_meshes::bytes("spot.obj") else { return };
     let split = spot_uv_split(&bytes);
     let r = analyze(&split);
     assert_eq!(r.vertices, 3_225);
