@@ -94,15 +94,10 @@ pub fn subdivide_midpoint(mesh: &Mesh, levels: u32) -> Mesh {
     Mesh::from_triangles(pos, &tris)
 }
 
-/// Faces fan-triangulated from their first corner.
+/// Faces as triangles (see [`Faces::triangles`]: fans from the first corner unless that fan would
+/// reuse an existing edge).
 pub fn fan_triangles(faces: &Faces) -> Vec<[u32; 3]> {
-    let mut tris = Vec::with_capacity(faces.len());
-    for f in faces.iter() {
-        for k in 1..f.len().saturating_sub(1) {
-            tris.push([f[0], f[k], f[k + 1]]);
-        }
-    }
-    tris
+    faces.triangles()
 }
 
 /// A planar grid in z = 0 of `nx × ny` cells with spacing `h`, as quads (`quads = true`) or as

@@ -114,7 +114,11 @@ fn cow_non_manifold_vertex_split() {
 #[test]
 fn suzanne_triangulated_non_manifold_edge_resolved() {
     let Some(m) = shared_meshes::load("suzanne.obj") else { return };
-    let tri = Mesh::from_triangles(m.positions.clone(), &shapes::fan_triangles(&m.faces));
+    // The naive fan from each face's first corner (Meshwork's own triangulation avoids this; see
+    // validate_shared.rs) puts 4 triangles on one edge: a real non-manifold edge to repair.
+    let naive: Vec<[u32; 3]> =
+        m.faces.iter().flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]])).collect();
+    let tri = Mesh::from_triangles(m.positions.clone(), &naive);
     assert_eq!(analyze(&tri).non_manifold_edges, 1);
     for mode in ["split", "remove"] {
         let (out, rep) = repair(tri.clone(), json!({"non_manifold": mode, "fill_holes": false}));

@@ -5,7 +5,6 @@ mod shared_meshes;
 
 use meshwork_core::io::{self, ReadOptions};
 use meshwork_core::mesh::{Faces, Mesh};
-use meshwork_core::shapes;
 use meshwork_core::validate::{analyze, Report};
 
 fn report(name: &str) -> Option<Report> {
@@ -63,10 +62,24 @@ fn suzanne_polygons_and_triangulated() {
     assert_eq!(r.face_arity.get("3"), Some(&32));
     assert_eq!(r.components, 3);
     assert_eq!(r.non_manifold_edges, 0);
-    let tri = Mesh::from_triangles(m.positions.clone(), &shapes::fan_triangles(&m.faces));
-    let t = analyze(&tri);
+    // The naive fan from every face's first corner (built here by hand) cuts both quads along
+    // their shared diagonal: that edge then has 4 triangles (the README's count).
+    let naive: Vec<[u32; 3]> =
+        m.faces.iter().flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]])).collect();
+    let t = analyze(&Mesh::from_triangles(m.positions.clone(), &naive));
     assert_eq!(t.non_manifold_edges, 1);
     assert_eq!(t.examples.non_manifold_edges, vec![[70, 138]]);
+    // Meshwork's triangulation (used by every writer and job that needs triangles) cuts the second
+    // quad along its other diagonal and keeps the mesh manifold.
+    let ours = analyze(&Mesh::from_triangles(m.positions.clone(), &m.faces.triangles()));
+    assert_eq!(ours.non_manifold_edges, 0);
+    assert_eq!(ours.faces, naive.len());
+    // The same through a triangles-only format: written as GLB and as STL, read back.
+    for fmt in [meshwork_core::io::Format::Glb, meshwork_core::io::Format::Stl] {
+        let bytes = meshwork_core::io::write(&m, fmt).expect("writes");
+        let back = meshwork_core::io::read(&bytes, &Default::default()).expect("reads back").mesh;
+        assert_eq!(analyze(&back).non_manifold_edges, 0, "{fmt:?}");
+    }
 }
 
 /// Teapot as read: an unwelded soup. Its parts touch only at vertices until welded.
