@@ -290,7 +290,10 @@ fn flatten_to_star(
         for v in 0..n {
             heap.push((Key(ks(&p, v).abs()), v as u32, 0));
         }
-        let mut parked = Vec::new();
+        // A vertex whose move would be too small is dropped from the heap: its curvature and
+        // target depend only on its neighbours, and when one of them moves it is queued again
+        // with a new stamp. (Re-queuing every parked vertex after each move made a round
+        // quadratic in the working size.)
         for _ in 0..5 * n {
             let mut moved = false;
             while let Some((_, v, st)) = heap.pop() {
@@ -303,7 +306,6 @@ fn flatten_to_star(
                     1.0 / nbrs[v].len() as f64,
                 );
                 if norm(sub(bary, p[v])) <= min_move {
-                    parked.push(v);
                     continue;
                 }
                 p[v] = bary;
@@ -313,9 +315,6 @@ fn flatten_to_star(
                 }
                 moved = true;
                 break;
-            }
-            for v in parked.drain(..) {
-                heap.push((Key(ks(&p, v).abs()), v as u32, stamp[v]));
             }
             if !moved {
                 break;
