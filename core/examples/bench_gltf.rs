@@ -8,22 +8,11 @@
 //! ```
 //! Prints `file<TAB>operation<TAB>meshwork<TAB>ms` (best of REPS), the shape bench/io_peers.py prints.
 
-use std::time::Instant;
+mod bench_support;
+use bench_support::best;
 
 use meshwork_core::io::gltf;
 use meshwork_core::shapes;
-
-fn best<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut t = f64::INFINITY;
-    let mut r = None;
-    for _ in 0..reps.max(1) {
-        let s = Instant::now();
-        let v = f();
-        t = t.min(s.elapsed().as_secs_f64() * 1e3);
-        r = Some(v);
-    }
-    (t, r.expect("at least one run"))
-}
 
 fn main() {
     let mut args = std::env::args().skip(1);

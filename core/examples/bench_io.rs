@@ -6,8 +6,10 @@
 //! usage: bench_io [MESH.obj] [--levels N] [--out DIR] [--reps N]
 //! (defaults: ../shared/meshes/stanford-bunny.obj, 3 levels ≈ 2.2M vertices, /tmp/meshwork-bench-io, 3)
 
+mod bench_support;
+use bench_support::best;
+
 use std::path::PathBuf;
-use std::time::Instant;
 
 use meshwork_core::io::{self, Format, ReadOptions};
 use meshwork_core::{shapes, validate, Mesh};
@@ -37,19 +39,6 @@ fn args() -> Args {
         }
     }
     a
-}
-
-/// Best wall time of `reps` runs, in ms, and the last result.
-fn best<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut t = f64::INFINITY;
-    let mut r = None;
-    for _ in 0..reps.max(1) {
-        let s = Instant::now();
-        let v = f();
-        t = t.min(s.elapsed().as_secs_f64() * 1e3);
-        r = Some(v);
-    }
-    (t, r.expect("at least one run"))
 }
 
 fn report(file: &str, op: &str, ms: f64) {

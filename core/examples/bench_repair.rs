@@ -8,6 +8,9 @@
 //! 500k faces: the minimum is the least disturbed by other processes on a shared machine) and
 //! the key counts of the reports; `--json` also prints the full reports.
 
+mod bench_support;
+use bench_support::best;
+
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -17,35 +20,26 @@ use meshwork_core::mesh::Mesh;
 use meshwork_core::shapes;
 use meshwork_core::topology::Topology;
 
-fn best_ms(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut t: Vec<f64> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    t.sort_by(|a, b| a.total_cmp(b));
-    t[0]
-}
-
 fn bench(name: &str, mesh: &Mesh, read_ms: f64, json: bool) {
     let runs = if mesh.face_count() > 500_000 { 3 } else { 7 };
-    let topo_ms = best_ms(runs, || {
+    let topo_ms = best(runs, || {
         std::hint::black_box(Topology::new(mesh));
-    });
+    })
+    .0;
     let mut vrep = serde_json::Value::Null;
-    let val_ms = best_ms(runs, || {
+    let val_ms = best(runs, || {
         vrep = job::run(JobKind::Validate, vec![mesh.clone()], serde_json::Value::Null, &Progress::new())
             .unwrap()
             .report;
-    });
+    })
+    .0;
     let mut rrep = serde_json::Value::Null;
-    let rep_ms = best_ms(runs, || {
+    let rep_ms = best(runs, || {
         rrep = job::run(JobKind::Repair, vec![mesh.clone()], serde_json::Value::Null, &Progress::new())
             .unwrap()
             .report;
-    });
+    })
+    .0;
     println!(
         "{name:<22} V={:<8} F={:<8} read {read_ms:>8.1} ms  topology {topo_ms:>7.1} ms  validate {val_ms:>7.1} ms  repair {rep_ms:>8.1} ms | comps {} loops {} nm_e {} nm_v {} pinch {} chi {} genus {} -> repaired V={} F={} comps {} loops {} closed {} manifold {} genus {} why {}",
         vrep["vertices"], vrep["faces"], vrep["components"], vrep["boundary_loops"], vrep["non_manifold_edges"],

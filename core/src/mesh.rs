@@ -115,6 +115,56 @@ impl Faces {
         self.all_triangles().then_some(&self.indices[..])
     }
 
+    /// The corner each face is fan-triangulated from (0 for triangles). Usually the first corner;
+    /// but when a diagonal of that fan is already an edge of the mesh (or a diagonal chosen for an
+    /// earlier polygon), the fan would put a third face on that edge and make a manifold polygon
+    /// mesh non-manifold once triangulated (Suzanne has such a quad). Then the first corner whose
+    /// diagonals are all new is the apex; when there is none, corner 0 stays (the input then
+    /// has that edge three times whichever way it is cut).
+    pub fn fan_apexes(&self) -> Vec<u32> {
+        let mut apex = vec![0u32; self.len()];
+        if self.all_triangles() {
+            return apex;
+        }
+        let key = |a: u32, b: u32| ((a.min(b) as u64) << 32) | a.max(b) as u64;
+        let mut edges: Vec<u64> = Vec::with_capacity(self.indices.len());
+        for f in self.iter() {
+            for k in 0..f.len() {
+                edges.push(key(f[k], f[(k + 1) % f.len()]));
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        let mut chosen: std::collections::HashSet<u64> = std::collections::HashSet::new();
+        let taken = |e: u64, chosen: &std::collections::HashSet<u64>| {
+            edges.binary_search(&e).is_ok() || chosen.contains(&e)
+        };
+        for (fi, f) in self.iter().enumerate() {
+            let n = f.len();
+            if n < 4 {
+                continue;
+            }
+            let free = |a: usize| (2..n - 1).all(|j| !taken(key(f[a], f[(a + j) % n]), &chosen));
+            let a = (0..n).find(|&a| free(a)).unwrap_or(0);
+            apex[fi] = a as u32;
+            for j in 2..n - 1 {
+                chosen.insert(key(f[a], f[(a + j) % n]));
+            }
+        }
+        apex
+    }
+
+    /// Every face as triangles, fanned from its [`Faces::fan_apexes`] corner, in face order;
+    /// faces with fewer than 3 corners give none.
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let apex = self.fan_apexes();
+        let mut tris = Vec::with_capacity(self.indices.len().saturating_sub(2 * self.len()));
+        for (f, &a) in self.iter().zip(&apex) {
+            fan_of(f, a as usize, |t| tris.push(t));
+        }
+        tris
+    }
+
     /// Keeps the faces for which `keep(face_index)` is true, in order.
     pub fn retain(&mut self, mut keep: impl FnMut(usize) -> bool) {
         let mut out = Faces::with_capacity(self.len(), self.indices.len());
@@ -124,6 +174,15 @@ impl Faces {
             }
         }
         *self = out;
+    }
+}
+
+/// Calls `emit` with the fan triangles of polygon `f` from corner `apex` (none below 3 corners).
+#[inline]
+pub fn fan_of(f: &[u32], apex: usize, mut emit: impl FnMut([u32; 3])) {
+    let n = f.len();
+    for j in 1..n.saturating_sub(1) {
+        emit([f[apex], f[(apex + j) % n], f[(apex + j + 1) % n]]);
     }
 }
 
@@ -228,6 +287,61 @@ mod tests {
         f.retain(|i| i == 1);
         assert_eq!(f.len(), 1);
         assert_eq!(f.get(0), &[0, 2, 3, 4]);
+    }
+
+    /// Uses per undirected edge, counted by hand from the triangle list.
+    fn max_edge_uses(tris: &[[u32; 3]]) -> usize {
+        let mut uses = std::collections::HashMap::new();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+            }
+        }
+        uses.into_values().max().unwrap_or(0)
+    }
+
+    #[test]
+    fn quads_fan_from_the_first_corner_when_nothing_is_in_the_way() {
+        let mut f = Faces::new();
+        f.push(&[0, 1, 2, 3], 0);
+        f.push(&[1, 4, 5, 2], 0);
+        assert_eq!(f.triangles(), vec![[0, 1, 2], [0, 2, 3], [1, 4, 5], [1, 5, 2]]);
+        assert_eq!(f.fan_apexes(), vec![0, 0]);
+    }
+
+    #[test]
+    fn a_diagonal_that_is_already_an_edge_is_not_used() {
+        // Quad 0-1-2-3 whose diagonal 0–2 is also the edge shared by two triangles on the other
+        // side (the Suzanne case): the fan from 0 would put four faces on 0–2.
+        let mut f = Faces::new();
+        f.push(&[0, 1, 2, 3], 0);
+        f.push(&[0, 4, 2], 0);
+        f.push(&[2, 5, 0], 0);
+        assert_eq!(f.fan_apexes(), vec![1, 0, 0]);
+        let tris = f.triangles();
+        assert_eq!(&tris[..2], &[[1, 2, 3], [1, 3, 0]]);
+        assert_eq!(max_edge_uses(&tris), 2);
+
+        // A pentagon with existing edges 0–2 and 1–4: the fans from 0 (0–2), 1 (1–4) and 2 (2–0)
+        // each hit one; the fan from 3 (3–0, 3–1) is the first free one.
+        let mut p = Faces::new();
+        p.push(&[0, 1, 2, 3, 4], 0);
+        p.push(&[0, 2, 9], 0);
+        p.push(&[1, 4, 9], 0);
+        assert_eq!(p.fan_apexes()[0], 3);
+        assert_eq!(p.triangles().len(), 3 + 2);
+    }
+
+    #[test]
+    fn two_polygons_do_not_pick_the_same_new_diagonal() {
+        // Quads 0-1-2-3 and 2-5-0-6 both have the diagonal 0–2; the second must take the other.
+        let mut f = Faces::new();
+        f.push(&[0, 1, 2, 3], 0);
+        f.push(&[2, 5, 0, 6], 0);
+        let tris = f.triangles();
+        assert_eq!(f.fan_apexes(), vec![0, 1]);
+        assert_eq!(max_edge_uses(&tris), 2);
     }
 
     #[test]

@@ -146,6 +146,210 @@ pub fn mean_curvature(op: &Operator, positions: &[Point3], skip: &[bool]) -> f64
     }
 }
 
+/// Quality measures of one state of a surface (see [`compare`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct SurfaceQuality {
+    pub area: f64,
+    /// Signed cone volume from the apex (see [`volume_about`]).
+    pub volume: f64,
+    pub angles: AngleStats,
+    /// Mass-weighted mean |H| from the cotangent operator with Voronoi mass (see [`mean_curvature`]).
+    pub mean_curvature: f64,
+}
+
+/// A surface before and after a deformation of its vertices (same faces).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Comparison {
+    pub before: SurfaceQuality,
+    pub after: SurfaceQuality,
+    /// See [`flipped_faces`].
+    pub flipped_faces: usize,
+}
+
+/// Everything the smooth report measures on the surface, before and after, in one pass over the
+/// triangles: area, cone volume from `apex`, angle statistics, flipped faces and the mean
+/// curvature (boundary vertices in `skip` excluded). Equal, up to rounding, to [`area`],
+/// [`volume_about`], [`angle_stats`], [`flipped_faces`] and [`mean_curvature`] on a cotangent
+/// operator with Voronoi mass, which cost two stencil builds and six passes; those remain the
+/// reference (and the path for polygon meshes).
+pub fn compare(
+    before: &[Point3],
+    after: &[Point3],
+    faces: &Faces,
+    apex: Point3,
+    skip: &[bool],
+) -> Comparison {
+    let Some(tris) = faces.as_triangles() else {
+        return compare_reference(before, after, faces, apex, skip);
+    };
+    let n = before.len();
+    let nt = tris.len() / 3;
+    // One chunk of triangles per thread, each with its own per-vertex accumulators (scatter
+    // without atomics); few chunks so the accumulators stay a small multiple of the mesh.
+    let chunks = if nt >= 50_000 { rayon::current_num_threads().clamp(1, 4) } else { 1 };
+    let per = nt.div_ceil(chunks).max(1);
+    let parts: Vec<(TriAcc, TriAcc, usize)> = tris
+        .par_chunks(3 * per)
+        .map(|t| {
+            let (mut a, mut b) = (TriAcc::new(n), TriAcc::new(n));
+            let mut flipped = 0;
+            for t in t.chunks_exact(3) {
+                let c0 = a.add(before, t, apex);
+                let c1 = b.add(after, t, apex);
+                flipped += (dot(c0, c1) < 0.0) as usize;
+            }
+            (a, b, flipped)
+        })
+        .collect();
+    let mut it = parts.into_iter();
+    let Some((mut a, mut b, mut flipped)) = it.next() else {
+        return Comparison::default();
+    };
+    for (pa, pb, f) in it {
+        a.merge(pa);
+        b.merge(pb);
+        flipped += f;
+    }
+    Comparison { before: a.finish(nt, skip), after: b.finish(nt, skip), flipped_faces: flipped }
+}
+
+fn compare_reference(
+    before: &[Point3],
+    after: &[Point3],
+    faces: &Faces,
+    apex: Point3,
+    skip: &[bool],
+) -> Comparison {
+    let state = |x: &[Point3]| SurfaceQuality {
+        area: area(x, faces),
+        volume: volume_about(x, faces, apex),
+        angles: angle_stats(x, faces),
+        mean_curvature: crate::laplacian::operator(
+            x,
+            faces,
+            crate::laplacian::OperatorKind::Cotan,
+            crate::laplacian::MassKind::Voronoi,
+        )
+        .map(|op| mean_curvature(&op, x, skip))
+        .unwrap_or(f64::NAN),
+    };
+    let (b, a) = rayon::join(|| state(before), || state(after));
+    Comparison { before: b, after: a, flipped_faces: flipped_faces(before, after, faces) }
+}
+
+/// Per-chunk sums of [`compare`] for one state.
+struct TriAcc {
+    twice_area: f64,
+    volume6: f64,
+    /// Largest / smallest cotangent key of any corner (smallest / largest angle), see `cot_key`.
+    max_cot: f64,
+    min_cot: f64,
+    sum_min_angle: f64,
+    /// Per vertex: (S x) and the Voronoi mass.
+    hm: Vec<[f64; 4]>,
+}
+
+/// Monotone decreasing in the corner angle `atan2(t, d)` (t = |u×v| ≥ 0, d = u·v): its cotangent,
+/// ±∞ for the flat angles of a degenerate triangle (0 when d ≥ 0, π when d < 0).
+#[inline]
+fn cot_key(d: f64, t: f64) -> f64 {
+    if t > 0.0 {
+        d / t
+    } else if d < 0.0 {
+        f64::NEG_INFINITY
+    } else {
+        f64::INFINITY
+    }
+}
+
+impl TriAcc {
+    fn new(n: usize) -> TriAcc {
+        TriAcc {
+            twice_area: 0.0,
+            volume6: 0.0,
+            max_cot: f64::NEG_INFINITY,
+            min_cot: f64::INFINITY,
+            sum_min_angle: 0.0,
+            hm: vec![[0.0; 4]; n],
+        }
+    }
+
+    /// Adds triangle `t` of state `x`; returns its (unnormalised) normal.
+    #[inline]
+    fn add(&mut self, x: &[Point3], t: &[u32], apex: Point3) -> Point3 {
+        let (i, j, k) = (t[0] as usize, t[1] as usize, t[2] as usize);
+        let p = [x[i], x[j], x[k]];
+        let (e01, e02, e12) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[2], p[1]));
+        let c = cross(e01, e02);
+        let tw = norm(c);
+        self.twice_area += tw;
+        self.volume6 += dot(sub(p[0], apex), cross(sub(p[1], apex), sub(p[2], apex)));
+        // u·v at each corner; the common |u×v| is `tw`. The smallest angle has the largest dot.
+        let d = [dot(e01, e02), -dot(e01, e12), dot(e02, e12)];
+        let (dmax, dmin) = (d[0].max(d[1]).max(d[2]), d[0].min(d[1]).min(d[2]));
+        self.sum_min_angle += tw.atan2(dmax);
+        self.max_cot = self.max_cot.max(cot_key(dmax, tw));
+        self.min_cot = self.min_cot.min(cot_key(dmin, tw));
+        // Cotangent Laplacian and Voronoi mass, with the operator's own per-triangle terms.
+        let (cot, vor, _, _) = crate::laplacian::triangle_terms(p);
+        let v = [i, j, k];
+        for q in 0..3 {
+            let (a, b) = (v[(q + 1) % 3], v[(q + 2) % 3]);
+            let w = 0.5 * cot[q];
+            let dx = sub(p[(q + 1) % 3], p[(q + 2) % 3]);
+            for r in 0..3 {
+                self.hm[a][r] += w * dx[r];
+                self.hm[b][r] -= w * dx[r];
+            }
+            self.hm[v[q]][3] += vor[q];
+        }
+        c
+    }
+
+    fn merge(&mut self, o: TriAcc) {
+        self.twice_area += o.twice_area;
+        self.volume6 += o.volume6;
+        self.max_cot = self.max_cot.max(o.max_cot);
+        self.min_cot = self.min_cot.min(o.min_cot);
+        self.sum_min_angle += o.sum_min_angle;
+        for (a, b) in self.hm.iter_mut().zip(&o.hm) {
+            for r in 0..4 {
+                a[r] += b[r];
+            }
+        }
+    }
+
+    fn finish(&self, triangles: usize, skip: &[bool]) -> SurfaceQuality {
+        let angles = if triangles == 0 {
+            AngleStats::default()
+        } else {
+            AngleStats {
+                min: 1f64.atan2(self.max_cot).to_degrees(),
+                mean_min: (self.sum_min_angle / triangles as f64).to_degrees(),
+                max: 1f64.atan2(self.min_cot).to_degrees(),
+            }
+        };
+        // Locking as the operator does (`laplacian::lock_degenerate`): mass ≤ 1e-12 × mean.
+        let (sum, cnt) =
+            self.hm.iter().filter(|h| h[3] > 0.0).fold((0.0, 0usize), |(s, c), h| (s + h[3], c + 1));
+        let lock = if cnt > 0 { crate::laplacian::LOCK_RELATIVE * sum / cnt as f64 } else { 0.0 };
+        let (mut num, mut den) = (0.0, 0.0);
+        for (h, &s) in self.hm.iter().zip(skip) {
+            if s || !(h[3] > lock) || !h[3].is_finite() {
+                continue;
+            }
+            num += 0.5 * norm([h[0], h[1], h[2]]);
+            den += h[3];
+        }
+        SurfaceQuality {
+            area: 0.5 * self.twice_area,
+            volume: self.volume6 / 6.0,
+            angles,
+            mean_curvature: if den > 0.0 { num / den } else { 0.0 },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,5 +384,87 @@ mod tests {
         let g = grid(2, 2, 1.0, true);
         assert!((area(&g.positions, &g.faces) - 4.0).abs() < 1e-15);
         assert_eq!(displacement(&g.positions, &g.positions), (0.0, 0.0));
+    }
+
+    /// Hand-known values on the unit right-triangle grid: every triangle is 45-45-90.
+    #[test]
+    fn fused_comparison_on_a_right_triangle_grid() {
+        for quads in [false, true] {
+            let g = grid(3, 3, 1.0, quads);
+            let mut mirrored = g.positions.clone();
+            for p in &mut mirrored {
+                p[0] = -p[0];
+            }
+            let skip = vec![false; g.vertex_count()];
+            let q = compare(&g.positions, &mirrored, &g.faces, [0.0, 0.0, 1.0], &skip);
+            for s in [q.before, q.after] {
+                assert!((s.area - 9.0).abs() < 1e-12, "{s:?}");
+                assert!((s.volume.abs() - 3.0).abs() < 1e-12, "cone of height 1 over area 9: {s:?}");
+                assert!((s.angles.min - 45.0).abs() < 1e-12 && (s.angles.max - 90.0).abs() < 1e-12);
+                assert!((s.angles.mean_min - 45.0).abs() < 1e-12);
+            }
+            assert_eq!(q.flipped_faces, g.face_count(), "mirroring flips every face");
+            assert!((q.before.volume + q.after.volume).abs() < 1e-12, "mirroring flips the sign");
+        }
+    }
+
+    #[test]
+    fn fused_comparison_of_a_flat_sheet_has_zero_interior_curvature() {
+        let g = crate::shapes::triangle_grid(6, 6, 0.5);
+        let st =
+            crate::laplacian::Stencil::new(&g.faces, g.vertex_count(), crate::laplacian::PairLayout::Edges)
+                .unwrap();
+        let boundary = st.boundary_vertices();
+        assert_eq!(boundary.iter().filter(|b| **b).count(), 20, "the 6×6 sheet's rim");
+        let q = compare(&g.positions, &g.positions, &g.faces, [0.0; 3], &boundary);
+        assert!(q.before.mean_curvature.abs() < 1e-12, "{q:?}");
+        assert!((q.before.angles.min - 60.0).abs() < 1e-12 && (q.before.angles.max - 60.0).abs() < 1e-12);
+        assert_eq!(q.flipped_faces, 0);
+    }
+
+    /// The fused pass against the separate reference functions on a bumpy sphere large enough
+    /// for the chunked (multi-accumulator) path, plus one collinear and one collapsed triangle.
+    #[test]
+    fn fused_comparison_equals_the_reference_measures() {
+        let m = icosphere(6, 2.0);
+        assert!(m.face_count() >= 50_000);
+        let bump = |p: &Point3, s: f64| {
+            let f = 1.0 + s * (3.0 * p[0]).sin() * (2.0 * p[1]).cos() + 0.02 * (17.0 * p[2]).sin();
+            [p[0] * f, p[1] * f, p[2] * f]
+        };
+        let x0: Vec<Point3> = m.positions.iter().map(|p| bump(p, 0.1)).collect();
+        let x1: Vec<Point3> = m.positions.iter().map(|p| bump(p, -0.05)).collect();
+        let mut skip = vec![false; x0.len()];
+        skip[3] = true;
+        let apex = [0.3, -0.2, 0.1];
+        let q = compare(&x0, &x1, &m.faces, apex, &skip);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-11 * b.abs().max(1e-300);
+        for (s, x) in [(q.before, &x0), (q.after, &x1)] {
+            assert!(close(s.area, area(x, &m.faces)));
+            assert!(close(s.volume, volume_about(x, &m.faces, apex)));
+            let a = angle_stats(x, &m.faces);
+            assert!(
+                close(s.angles.min, a.min)
+                    && close(s.angles.mean_min, a.mean_min)
+                    && close(s.angles.max, a.max)
+            );
+            let op = operator(x, &m.faces, OperatorKind::Cotan, MassKind::Voronoi).unwrap();
+            assert!(
+                close(s.mean_curvature, mean_curvature(&op, x, &skip)),
+                "{} {}",
+                s.mean_curvature,
+                mean_curvature(&op, x, &skip)
+            );
+        }
+        assert_eq!(q.flipped_faces, flipped_faces(&x0, &x1, &m.faces));
+        // Degenerate triangles: a collinear one (angles 0, 0, 180) and a collapsed one (all 0).
+        let p = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let mut f = Faces::new();
+        f.push(&[0, 1, 2], 0);
+        f.push(&[0, 1, 3], 0);
+        let q = compare(&p, &p, &f, [0.0; 3], &[false; 4]);
+        let a = angle_stats(&p, &f);
+        assert_eq!((q.before.angles.min, q.before.angles.max), (0.0, 180.0));
+        assert!(close(q.before.angles.mean_min, a.mean_min) && a.min == 0.0 && a.max == 180.0);
     }
 }

@@ -94,15 +94,10 @@ pub fn subdivide_midpoint(mesh: &Mesh, levels: u32) -> Mesh {
     Mesh::from_triangles(pos, &tris)
 }
 
-/// Faces fan-triangulated from their first corner.
+/// Faces as triangles (see [`Faces::triangles`]: fans from the first corner unless that fan would
+/// reuse an existing edge).
 pub fn fan_triangles(faces: &Faces) -> Vec<[u32; 3]> {
-    let mut tris = Vec::with_capacity(faces.len());
-    for f in faces.iter() {
-        for k in 1..f.len().saturating_sub(1) {
-            tris.push([f[0], f[k], f[k + 1]]);
-        }
-    }
-    tris
+    faces.triangles()
 }
 
 /// A planar grid in z = 0 of `nx × ny` cells with spacing `h`, as quads (`quads = true`) or as
@@ -126,15 +121,20 @@ pub fn parallelogram_grid(nx: usize, ny: usize, u: Point3, v: Point3, quads: boo
     for j in 0..ny {
         for i in 0..nx {
             let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if quads {
-                faces.push(&[a, b, c, d], 0);
-            } else {
-                faces.push(&[a, b, c], 0);
-                faces.push(&[a, c, d], 0);
-            }
+            push_quad(&mut faces, [a, b, c, d], quads);
         }
     }
     Mesh::new(pos, faces)
+}
+
+/// Pushes the quad `q` (counter-clockwise), or its two triangles split along the diagonal q0–q2.
+fn push_quad(faces: &mut Faces, q: [u32; 4], quads: bool) {
+    if quads {
+        faces.push(&q, 0);
+    } else {
+        faces.push(&[q[0], q[1], q[2]], 0);
+        faces.push(&[q[0], q[2], q[3]], 0);
+    }
 }
 
 /// Equilateral triangle grid of `nx × ny` vertices with edge length `h` (rows offset by h/2):
@@ -181,12 +181,7 @@ pub fn torus(nu: usize, nv: usize, r_major: f64, r_minor: f64, quads: bool) -> M
     for i in 0..nu {
         for j in 0..nv {
             let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            if quads {
-                faces.push(&[a, b, c, d], 0);
-            } else {
-                faces.push(&[a, b, c], 0);
-                faces.push(&[a, c, d], 0);
-            }
+            push_quad(&mut faces, [a, b, c, d], quads);
         }
     }
     Mesh::new(pos, faces)

@@ -1,26 +1,12 @@
 //! OBJ against the shared real meshes (counts from ../shared/meshes/README.md) and round trips.
 
+mod shared_meshes;
+
 use std::collections::HashSet;
-use std::path::PathBuf;
 
 use meshwork_core::io::{self, Format, ReadOptions};
 use meshwork_core::mesh::{Faces, Mesh};
 use meshwork_core::shapes;
-
-/// The shared meshes folder (`../shared/meshes` from the project root). They are not part of the
-/// repository; on a machine without them the real-mesh tests say so and pass vacuously.
-fn shared_mesh(name: &str) -> Option<Vec<u8>> {
-    let dir = std::env::var_os("MESHWORK_MESHES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes"));
-    match std::fs::read(dir.join(name)) {
-        Ok(b) => Some(b),
-        Err(e) => {
-            eprintln!("SKIP {name}: {e} (set MESHWORK_MESHES to the shared meshes folder)");
-            None
-        }
-    }
-}
 
 fn read(bytes: &[u8]) -> io::Loaded {
     io::read(bytes, &ReadOptions::default()).expect("readable")
@@ -57,7 +43,7 @@ fn shared_meshes_match_readme_counts() {
         ("teapot.obj", 3644, 6320),
     ];
     for (name, nv, nf) in plain {
-        let Some(b) = shared_mesh(name) else { continue };
+        let Some(b) = shared_meshes::bytes(name) else { continue };
         let l = read(&b);
         assert_eq!(l.format, Format::Obj);
         assert_eq!(l.mesh.vertex_count(), nv, "{name}");
@@ -65,7 +51,7 @@ fn shared_meshes_match_readme_counts() {
         assert_eq!(referenced(&l.mesh), nv, "{name}: every vertex used");
     }
     // Teapot: "3,644 (3,241 welded)" = distinct exact positions.
-    if let Some(b) = shared_mesh("teapot.obj") {
+    if let Some(b) = shared_meshes::bytes("teapot.obj") {
         assert_eq!(distinct_positions(&read(&b).mesh), 3241);
     }
 }
@@ -76,7 +62,7 @@ fn shared_meshes_match_readme_counts() {
 fn shared_meshes_where_readme_counts_differ() {
     // Bunny: the file has 35,947 `v` lines; the README's 34,834 are the vertices faces use (the
     // Python library drops unreferenced ones). We keep file indices, so 1,113 stay unreferenced.
-    if let Some(b) = shared_mesh("stanford-bunny.obj") {
+    if let Some(b) = shared_meshes::bytes("stanford-bunny.obj") {
         let m = read(&b).mesh;
         assert_eq!(m.vertex_count(), 35947);
         assert_eq!(referenced(&m), 34834);
@@ -84,7 +70,7 @@ fn shared_meshes_where_readme_counts_differ() {
     }
     // Suzanne: 507 vertices, 468 quads + 32 triangles, `f v//vn` with vn index = v index, so the
     // normals are consistent per vertex and kept.
-    if let Some(b) = shared_mesh("suzanne.obj") {
+    if let Some(b) = shared_meshes::bytes("suzanne.obj") {
         let m = read(&b).mesh;
         assert_eq!(m.vertex_count(), 507);
         assert_eq!(arity_histogram(&m.faces), vec![(3, 32), (4, 468)]);
@@ -93,7 +79,7 @@ fn shared_meshes_where_readme_counts_differ() {
     }
     // Spot: 2,930 `v` lines, 3,225 `vt`; the README's 3,225 vertices are the Python library's
     // split at UV seams. We do not split: the UVs conflict at seams and are dropped, with a warning.
-    if let Some(b) = shared_mesh("spot.obj") {
+    if let Some(b) = shared_meshes::bytes("spot.obj") {
         let l = read(&b);
         assert_eq!(l.mesh.vertex_count(), 2930);
         assert_eq!(arity_histogram(&l.mesh.faces), vec![(3, 5856)]);
@@ -103,7 +89,7 @@ fn shared_meshes_where_readme_counts_differ() {
     // Beetle: 1,148 `v`, 1,212 `vn`; the README's 1,254 is again a split by (v, vn) pairs. Some
     // vertex has two normals (a crease) so the normals are dropped; `usemtl`/`s`/`mtllib` are
     // counted as ignored; `o VWBUG` names the single group.
-    if let Some(b) = shared_mesh("beetle.obj") {
+    if let Some(b) = shared_meshes::bytes("beetle.obj") {
         let l = read(&b);
         assert_eq!(l.mesh.vertex_count(), 1148);
         assert_eq!(arity_histogram(&l.mesh.faces), vec![(3, 2053)]);
@@ -174,7 +160,7 @@ fn group_ids_are_renumbered_by_first_use() {
 #[test]
 fn shared_mesh_round_trips() {
     for name in ["suzanne.obj", "beetle.obj", "stanford-bunny.obj"] {
-        let Some(b) = shared_mesh(name) else { continue };
+        let Some(b) = shared_meshes::bytes(name) else { continue };
         let m = read(&b).mesh;
         let back = read(&io::write(&m, Format::Obj).unwrap()).mesh;
         assert_same(&m, &back);

@@ -1,30 +1,12 @@
 //! The repair job on the shared real meshes and on damaged analytic shapes.
 
-use std::path::PathBuf;
+mod shared_meshes;
 
-use meshwork_core::io::{self, ReadOptions};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Faces, Mesh};
 use meshwork_core::shapes;
 use meshwork_core::validate::analyze;
 use serde_json::{json, Value};
-
-fn shared(name: &str) -> Option<Vec<u8>> {
-    let dir = std::env::var_os("MESHWORK_MESHES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes"));
-    match std::fs::read(dir.join(name)) {
-        Ok(b) => Some(b),
-        Err(e) => {
-            eprintln!("SKIP {name}: {e} (set MESHWORK_MESHES to the shared meshes folder)");
-            None
-        }
-    }
-}
-
-fn load(name: &str) -> Option<Mesh> {
-    Some(io::read(&shared(name)?, &ReadOptions::default()).expect("readable").mesh)
-}
 
 fn repair(m: Mesh, params: Value) -> (Mesh, Value) {
     let mut out = job::run(JobKind::Repair, vec![m], params, &Progress::new()).expect("repair runs");
@@ -49,7 +31,7 @@ fn only(steps: &[&str]) -> Value {
 
 #[test]
 fn teapot_welds_to_3241_vertices_4_components() {
-    let Some(m) = load("teapot.obj") else { return };
+    let Some(m) = shared_meshes::load("teapot.obj") else { return };
     let (out, rep) = repair(m, only(&["weld", "remove_unreferenced"]));
     assert_eq!(out.vertex_count(), 3_241, "README: 3,241 welded");
     assert_eq!(rep["steps"]["weld"]["merged_vertices"], 403);
@@ -59,7 +41,7 @@ fn teapot_welds_to_3241_vertices_4_components() {
 
 #[test]
 fn bunny_holes_filled_closed_genus_zero_outward() {
-    let Some(m) = load("stanford-bunny.obj") else { return };
+    let Some(m) = shared_meshes::load("stanford-bunny.obj") else { return };
     let area_before = analyze(&m).area;
     let (out, rep) = repair(m, Value::Null);
     let r = analyze(&out);
@@ -78,7 +60,7 @@ fn bunny_holes_filled_closed_genus_zero_outward() {
 
 #[test]
 fn spot_uv_split_welds_to_one_closed_piece() {
-    let Some(bytes) = shared("spot.obj") else { return };
+    let Some(bytes) = shared_meshes::bytes("spot.obj") else { return };
     // Same construction as validate_shared: one vertex per (v, vt) pair → 13 pieces.
     let text = std::str::from_utf8(&bytes).unwrap();
     let pos: Vec<[f64; 3]> = text
@@ -120,7 +102,7 @@ fn spot_uv_split_welds_to_one_closed_piece() {
 
 #[test]
 fn cow_non_manifold_vertex_split() {
-    let Some(m) = load("cow.obj") else { return };
+    let Some(m) = shared_meshes::load("cow.obj") else { return };
     let (out, rep) = repair(m, json!({"non_manifold": "split"}));
     assert_eq!(rep["steps"]["non_manifold"]["vertices_split"], 1);
     let r = analyze(&out);
@@ -131,8 +113,12 @@ fn cow_non_manifold_vertex_split() {
 
 #[test]
 fn suzanne_triangulated_non_manifold_edge_resolved() {
-    let Some(m) = load("suzanne.obj") else { return };
-    let tri = Mesh::from_triangles(m.positions.clone(), &shapes::fan_triangles(&m.faces));
+    let Some(m) = shared_meshes::load("suzanne.obj") else { return };
+    // The naive fan from each face's first corner (Meshwork's own triangulation avoids this; see
+    // validate_shared.rs) puts 4 triangles on one edge: a real non-manifold edge to repair.
+    let naive: Vec<[u32; 3]> =
+        m.faces.iter().flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]])).collect();
+    let tri = Mesh::from_triangles(m.positions.clone(), &naive);
     assert_eq!(analyze(&tri).non_manifold_edges, 1);
     for mode in ["split", "remove"] {
         let (out, rep) = repair(tri.clone(), json!({"non_manifold": mode, "fill_holes": false}));
@@ -147,7 +133,7 @@ fn suzanne_triangulated_non_manifold_edge_resolved() {
 
 #[test]
 fn beetle_tangle_does_not_panic_and_ends_without_non_manifold_edges() {
-    let Some(m) = load("beetle.obj") else { return };
+    let Some(m) = shared_meshes::load("beetle.obj") else { return };
     let before = analyze(&m);
     assert!(before.non_manifold_edges > 0);
     let (out, rep) = repair(m, Value::Null);

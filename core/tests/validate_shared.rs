@@ -1,33 +1,14 @@
 //! Validation reports of the shared real meshes against the counts in ../shared/meshes/README.md
 //! (made by other people with other tools), and against counts derived here from the raw files.
 
-use std::path::PathBuf;
+mod shared_meshes;
 
 use meshwork_core::io::{self, ReadOptions};
 use meshwork_core::mesh::{Faces, Mesh};
-use meshwork_core::shapes;
 use meshwork_core::validate::{analyze, Report};
 
-/// The shared meshes folder; on a machine without it the real-mesh tests say so and pass.
-fn shared(name: &str) -> Option<Vec<u8>> {
-    let dir = std::env::var_os("MESHWORK_MESHES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes"));
-    match std::fs::read(dir.join(name)) {
-        Ok(b) => Some(b),
-        Err(e) => {
-            eprintln!("SKIP {name}: {e} (set MESHWORK_MESHES to the shared meshes folder)");
-            None
-        }
-    }
-}
-
-fn load(name: &str) -> Option<Mesh> {
-    Some(io::read(&shared(name)?, &ReadOptions::default()).expect("readable").mesh)
-}
-
 fn report(name: &str) -> Option<Report> {
-    load(name).map(|m| analyze(&m))
+    shared_meshes::load(name).map(|m| analyze(&m))
 }
 
 #[test]
@@ -74,17 +55,31 @@ fn cow_odd_euler_is_a_non_manifold_vertex() {
 /// components" we do not reproduce: trimesh also reports 3 bodies.)
 #[test]
 fn suzanne_polygons_and_triangulated() {
-    let Some(m) = load("suzanne.obj") else { return };
+    let Some(m) = shared_meshes::load("suzanne.obj") else { return };
     let r = analyze(&m);
     assert_eq!(r.faces, 500);
     assert_eq!(r.face_arity.get("4"), Some(&468));
     assert_eq!(r.face_arity.get("3"), Some(&32));
     assert_eq!(r.components, 3);
     assert_eq!(r.non_manifold_edges, 0);
-    let tri = Mesh::from_triangles(m.positions.clone(), &shapes::fan_triangles(&m.faces));
-    let t = analyze(&tri);
+    // The naive fan from every face's first corner (built here by hand) cuts both quads along
+    // their shared diagonal: that edge then has 4 triangles (the README's count).
+    let naive: Vec<[u32; 3]> =
+        m.faces.iter().flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]])).collect();
+    let t = analyze(&Mesh::from_triangles(m.positions.clone(), &naive));
     assert_eq!(t.non_manifold_edges, 1);
     assert_eq!(t.examples.non_manifold_edges, vec![[70, 138]]);
+    // Meshwork's triangulation (used by every writer and job that needs triangles) cuts the second
+    // quad along its other diagonal and keeps the mesh manifold.
+    let ours = analyze(&Mesh::from_triangles(m.positions.clone(), &m.faces.triangles()));
+    assert_eq!(ours.non_manifold_edges, 0);
+    assert_eq!(ours.faces, naive.len());
+    // The same through a triangles-only format: written as GLB and as STL, read back.
+    for fmt in [meshwork_core::io::Format::Glb, meshwork_core::io::Format::Stl] {
+        let bytes = meshwork_core::io::write(&m, fmt).expect("writes");
+        let back = meshwork_core::io::read(&bytes, &Default::default()).expect("reads back").mesh;
+        assert_eq!(analyze(&back).non_manifold_edges, 0, "{fmt:?}");
+    }
 }
 
 /// Teapot as read: an unwelded soup. Its parts touch only at vertices until welded.
@@ -134,7 +129,7 @@ pub fn spot_uv_split(bytes: &[u8]) -> Mesh {
 
 #[test]
 fn spot_thirteen_pieces_until_welded() {
-    let Some(bytes) = shared("spot.obj") else { return };
+    let Some(bytes) = shared_meshes::bytes("spot.obj") else { return };
     let split = spot_uv_split(&bytes);
     let r = analyze(&split);
     assert_eq!(r.vertices, 3_225);

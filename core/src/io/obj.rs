@@ -47,11 +47,51 @@ pub(crate) fn looks_like_obj(text: &[u8]) -> bool {
 /// Decodes OBJ bytes.
 pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let joined = join_continuations(bytes);
+    let bytes: &[u8] = &joined;
     let target = (bytes.len() / (4 * rayon::current_num_threads().max(1))).max(1 << 20);
     #[allow(clippy::single_range_in_vec_init)] // one range = the whole file, sequentially
     let ranges =
         if bytes.len() < PARALLEL_BYTES { vec![0..bytes.len()] } else { chunk_ranges(bytes, target) };
     read_chunks(bytes, opts, &ranges)
+}
+
+/// Joins lines continued with a trailing backslash (`v 1 2 \` + newline + `3`), which the OBJ
+/// format allows. The backslash and its line break become spaces and the line break is re-emitted
+/// after the end of the joined line, so every line after it keeps its number (and an error inside
+/// a joined statement is reported at its first line). Borrowed unchanged when there is nothing to
+/// join, which is nearly always.
+fn join_continuations(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    let continued = |i: usize| match bytes.get(i + 1) {
+        Some(b'\n') => Some(2),
+        Some(b'\r') if bytes.get(i + 2) == Some(&b'\n') => Some(3),
+        _ => None,
+    };
+    if !memchr::memchr_iter(b'\\', bytes).any(|i| continued(i).is_some()) {
+        return std::borrow::Cow::Borrowed(bytes);
+    }
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut pending = 0usize;
+    let mut i = 0;
+    while i < bytes.len() {
+        let b = bytes[i];
+        if b == b'\\' {
+            if let Some(len) = continued(i) {
+                out.extend(std::iter::repeat_n(b' ', len));
+                pending += 1;
+                i += len;
+                continue;
+            }
+        }
+        out.push(b);
+        if b == b'\n' {
+            out.extend(std::iter::repeat_n(b'\n', pending));
+            pending = 0;
+        }
+        i += 1;
+    }
+    out.extend(std::iter::repeat_n(b'\n', pending));
+    std::borrow::Cow::Owned(out)
 }
 
 /// Parses the given newline-aligned ranges (in parallel when there are several) and stitches them.
@@ -834,6 +874,18 @@ mod tests {
         assert_eq!(m.groups, vec!["top".to_string(), "side".to_string()]);
         assert_eq!(m.faces.groups(), &[0, 1, 0]);
         assert_eq!(m.curves, vec![vec![0, 4]]);
+    }
+
+    #[test]
+    fn backslash_continues_a_line_and_later_line_numbers_stay() {
+        let l = read_str("v 0 0 0\nv 1 0 \\\n 0\nv 0 1 0\r\nf 1 \\\r\n2 3\n").unwrap();
+        assert_eq!(l.mesh.positions, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(l.mesh.faces.get(0), &[0, 1, 2]);
+        // Line 5 (1-based) is the bad one: the continuation on line 2 must not shift it.
+        let e = read_str("v 0 0 0\nv 1 0 \\\n 0\nv 0 1 0\nv x 1 0\n").unwrap_err();
+        assert_eq!(line_of(&e), Some(5), "{e}");
+        // A backslash that does not end a line is an ordinary character (here: not a number).
+        assert!(read_str("v 0 \\ 0 0\n").is_err());
     }
 
     #[test]

@@ -353,17 +353,15 @@ pub fn write(mesh: &Mesh) -> Result<Vec<u8>> {
     header[..text.len()].copy_from_slice(text);
     out.extend_from_slice(&header);
     out.extend_from_slice(&ntri32.to_le_bytes());
-    for f in mesh.faces.iter() {
-        for k in 1..f.len().saturating_sub(1) {
-            let tri = [f[0], f[k], f[k + 1]].map(|i| mesh.positions[i as usize]);
-            let n = geometry::normalize(geometry::triangle_cross(tri[0], tri[1], tri[2]));
-            for v in std::iter::once(n).chain(tri) {
-                for c in v {
-                    out.extend_from_slice(&(c as f32).to_le_bytes());
-                }
+    for tri in mesh.faces.triangles() {
+        let tri = tri.map(|i| mesh.positions[i as usize]);
+        let n = geometry::normalize(geometry::triangle_cross(tri[0], tri[1], tri[2]));
+        for v in std::iter::once(n).chain(tri) {
+            for c in v {
+                out.extend_from_slice(&(c as f32).to_le_bytes());
             }
-            out.extend_from_slice(&[0, 0]);
         }
+        out.extend_from_slice(&[0, 0]);
     }
     Ok(out)
 }

@@ -281,12 +281,125 @@ impl Stencil {
         Ok(Stencil { n, layout, pair_offset, pattern, slot_ptr, entry, edge_mult, diag_pos })
     }
 
+    /// The pattern of the uniform (umbrella) operator only: edge neighbours, edge multiplicities
+    /// and the diagonal, without the per-pair entry lists that weighted assembly needs (so about
+    /// half the work and memory of [`Stencil::new`]). [`Stencil::stiffness`] must not be called on
+    /// it; [`Stencil::uniform_stiffness`] and everything topological works.
+    pub fn uniform(faces: &Faces, n: usize) -> Result<Stencil> {
+        let corners = faces.indices().len();
+        if 2 * corners >= u32::MAX as usize {
+            return Err(too_large("operator entries", 2 * corners));
+        }
+        // Directed neighbour entries (both directions of every polygon edge), counting sort by row.
+        let mut count = vec![0u32; n + 1];
+        let each_edge = |g: &mut dyn FnMut(u32, u32)| {
+            if let Some(t) = faces.as_triangles() {
+                for t in t.chunks_exact(3) {
+                    g(t[0], t[1]);
+                    g(t[1], t[2]);
+                    g(t[2], t[0]);
+                }
+            } else {
+                for f in faces.iter() {
+                    for k in 0..f.len() {
+                        g(f[k], f[(k + 1) % f.len()]);
+                    }
+                }
+            }
+        };
+        each_edge(&mut |a, b| {
+            if a != b {
+                count[a as usize + 1] += 1;
+                count[b as usize + 1] += 1;
+            }
+        });
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let ent_ptr = count.clone();
+        let mut fill = count;
+        let mut nb = vec![0u32; ent_ptr[n] as usize];
+        each_edge(&mut |a, b| {
+            if a != b {
+                nb[fill[a as usize] as usize] = b;
+                fill[a as usize] += 1;
+                nb[fill[b as usize] as usize] = a;
+                fill[b as usize] += 1;
+            }
+        });
+        drop(fill);
+        // Per row: sort, count distinct neighbours (+ the diagonal).
+        let row_len: Vec<u32> = split_rows_mut(&mut nb, &ent_ptr)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|r| {
+                r.sort_unstable();
+                1 + r.iter().enumerate().filter(|&(k, &c)| k == 0 || r[k - 1] != c).count() as u32
+            })
+            .collect();
+        let mut row_ptr = Vec::with_capacity(n + 1);
+        row_ptr.push(0u32);
+        let mut acc = 0u64;
+        for &l in &row_len {
+            acc += l as u64;
+            row_ptr.push(u32::try_from(acc).map_err(|_| too_large("operator entries", acc as usize))?);
+        }
+        let nnz = acc as usize;
+        let mut col = vec![0u32; nnz];
+        let mut edge_mult = vec![0u8; nnz];
+        let mut diag_pos = vec![0usize; n];
+        split_rows_mut(&mut col, &row_ptr)
+            .into_par_iter()
+            .zip(split_rows_mut(&mut edge_mult, &row_ptr))
+            .zip(diag_pos.par_iter_mut())
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(i, ((cols, mults), dpos))| {
+                let r = &nb[ent_ptr[i] as usize..ent_ptr[i + 1] as usize];
+                let (mut s, mut k) = (0usize, 0usize);
+                let mut diag_done = false;
+                while k < r.len() || !diag_done {
+                    let c = if k < r.len() { r[k] } else { u32::MAX };
+                    if !diag_done && (i as u32) < c {
+                        cols[s] = i as u32;
+                        mults[s] = 0;
+                        *dpos = row_ptr[i] as usize + s;
+                        s += 1;
+                        diag_done = true;
+                        continue;
+                    }
+                    let start = k;
+                    while k < r.len() && r[k] == c {
+                        k += 1;
+                    }
+                    cols[s] = c;
+                    mults[s] = (k - start).min(255) as u8;
+                    s += 1;
+                }
+            });
+        let pattern = Csr { n, row_ptr, col, val: vec![0.0; nnz] };
+        Ok(Stencil {
+            n,
+            layout: PairLayout::Edges,
+            pair_offset: vec![0],
+            pattern,
+            slot_ptr: Vec::new(),
+            entry: Vec::new(),
+            edge_mult,
+            diag_pos,
+        })
+    }
+
     pub fn pair_count(&self) -> usize {
         *self.pair_offset.last().unwrap_or(&0) as usize
     }
 
     /// Stiffness `S` from per-pair weights: `S_ij = −½ Σ w_pair`, diagonal = −Σ off-diagonals.
     pub fn stiffness(&self, pair_w: &[f64]) -> Csr {
+        assert!(
+            self.slot_ptr.len() == self.pattern.nnz() + 1,
+            "Stencil::stiffness needs a stencil built by Stencil::new (not Stencil::uniform)"
+        );
         let mut s = self.pattern.clone();
         let slot_ptr = &self.slot_ptr;
         let entry = &self.entry;
@@ -390,7 +503,7 @@ pub struct FaceTerms {
 
 /// Per-corner terms of one triangle: cot at each corner, barycentric, Voronoi, ring area.
 #[inline]
-fn triangle_terms(p: [Point3; 3]) -> ([f64; 3], [f64; 3], f64, bool) {
+pub(crate) fn triangle_terms(p: [Point3; 3]) -> ([f64; 3], [f64; 3], f64, bool) {
     let e = [sub(p[2], p[1]), sub(p[0], p[2]), sub(p[1], p[0])]; // edge opposite corner c
     let l2 = [dot(e[0], e[0]), dot(e[1], e[1]), dot(e[2], e[2])];
     let twice_area = norm(cross(e[2], sub(p[2], p[0])));

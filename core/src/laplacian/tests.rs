@@ -208,3 +208,38 @@ fn degenerate_triangle_gives_no_weight_and_isolated_vertex_is_locked() {
     assert!(!o.locked[3]);
     assert!(o.stiffness.val.iter().all(|v| v.is_finite()));
 }
+
+/// The uniform-only stencil has the same pattern, edge multiplicities and diagonal positions as
+/// the full one (Edges layout), on triangles, a hybrid polygon mesh, a repeated corner, a
+/// non-manifold fin and an isolated vertex; and its umbrella stiffness is the hand-known one.
+#[test]
+fn uniform_stencil_equals_the_edge_pattern_of_the_full_one() {
+    let mut cases = vec![triangle_grid(5, 4, 1.0), grid(3, 3, 1.0, true), planar_hybrid()];
+    let mut fin = grid(2, 1, 1.0, false);
+    fin.positions.push([0.5, 0.5, 1.0]);
+    fin.positions.push([9.0, 9.0, 9.0]); // isolated
+    let apex = fin.positions.len() as u32 - 2;
+    let mut faces = fin.faces.clone();
+    faces.push(&[1, 4, apex], 0); // edge 1–4 now has three faces
+    faces.push(&[0, 0, 1], 0); // repeated corner
+    fin.faces = faces;
+    cases.push(fin);
+    for m in &cases {
+        let n = m.vertex_count();
+        let full = Stencil::new(&m.faces, n, PairLayout::Edges).unwrap();
+        let uni = Stencil::uniform(&m.faces, n).unwrap();
+        assert_eq!(uni.pattern, full.pattern);
+        assert_eq!(uni.edge_mult, full.edge_mult);
+        assert_eq!(uni.diag_pos, full.diag_pos);
+        assert_eq!(uni.uniform_stiffness(), full.uniform_stiffness());
+        assert_eq!(uni.boundary_vertices(), full.boundary_vertices());
+        assert_eq!(uni.nonmanifold_edges(), full.nonmanifold_edges());
+    }
+    // Fin: vertex 1 has neighbours 0, 2, 4, 5 (grid, diagonal 1–5) and the apex: valence 5. Edge
+    // 1–4 has three faces, and so has 0–1 (its grid triangle plus the face [0, 0, 1] twice).
+    let m = &cases[3];
+    let s = Stencil::uniform(&m.faces, m.vertex_count()).unwrap().uniform_stiffness();
+    assert_eq!(s.get(1, 1), 5.0);
+    assert_eq!(Stencil::uniform(&m.faces, m.vertex_count()).unwrap().nonmanifold_edges(), 2);
+    assert_eq!(s.get(7, 7), 0.0, "isolated vertex: empty row but for the diagonal");
+}

@@ -33,7 +33,9 @@ impl TriMesh {
     pub fn from_mesh(mesh: &Mesh) -> (TriMesh, Vec<u32>, Conversion) {
         let mut conv = Conversion::default();
         let mut tris = Vec::with_capacity(mesh.faces.len());
-        for f in mesh.faces.iter() {
+        // Fans that never reuse an existing edge (see `Faces::fan_apexes`).
+        let apex = mesh.faces.fan_apexes();
+        for (f, &a) in mesh.faces.iter().zip(&apex) {
             if f.len() < 3 {
                 conv.faces_dropped += 1;
                 continue;
@@ -41,9 +43,7 @@ impl TriMesh {
             if f.len() > 3 {
                 conv.polygons_triangulated += 1;
             }
-            for k in 1..f.len() - 1 {
-                tris.push([f[0], f[k], f[k + 1]]);
-            }
+            crate::mesh::fan_of(f, a as usize, |t| tris.push(t));
         }
         let mut map = vec![u32::MAX; mesh.positions.len()];
         let mut pos = Vec::with_capacity(mesh.positions.len());

@@ -17,6 +17,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
     match ctx.r.method {
         Method::Laplacian | Method::Taubin => {
             let rows = explicit_rows(ctx);
+            let gain = explicit_gain(ctx);
             let n = ctx.r.iterations as usize;
             let factors: &[f64] =
                 if ctx.r.method == Method::Taubin { &[ctx.r.lambda, ctx.r.mu] } else { &[ctx.r.lambda] };
@@ -26,7 +27,7 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
                 ctx.tick(it, n)?;
                 let before = if keep_before { x.clone() } else { Vec::new() };
                 for &f in factors {
-                    explicit_step(ctx, &rows, &x, &mut out, f);
+                    explicit_step(&rows, gain.as_deref(), &x, &mut out, f);
                     std::mem::swap(&mut x, &mut out);
                 }
                 if keep_before || ctx.r.preserve_volume {
@@ -39,6 +40,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
         Method::Inflate => inflate(ctx, &mut x)?,
         Method::Fair => fair(ctx, &mut x)?,
         Method::Tangential => tangential(ctx, &mut x)?,
+        // Dispatched before the shared preparation (its own pipeline: smooth::highlight).
+        Method::Highlight => return Err(Error::Internal("highlight reached the Laplacian methods".into())),
     }
     Ok(x)
 }
@@ -46,14 +49,13 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
 /// Normalised explicit rows: `R = diag(S)⁻¹ S` (diagonal 1), boundary curve rows (½ of eq. 4-3,
 /// times `lambda_border`) in curve mode. One matrix for every operator, so λ ∈ (0, 1] is stable
 /// whatever the weights and the model's scale.
-fn explicit_rows(ctx: &Ctx) -> Rows {
+fn explicit_rows<'a>(ctx: &'a Ctx) -> Rows<'a> {
     let s = &ctx.op.stiffness;
     if ctx.op.kind == OperatorKind::Uniform
         && ctx.r.boundary != BoundaryMode::Curve
         && ctx.stencil.layout == PairLayout::Edges
     {
-        let inv_deg = s.diagonal().iter().map(|&d| if d > 0.0 { 1.0 / d } else { 0.0 }).collect();
-        return Rows::Umbrella { pattern: ctx.stencil.pattern.clone(), inv_deg };
+        return Rows::Umbrella(&ctx.stencil.pattern);
     }
     let mut r = s.clone();
     let curve = (ctx.r.boundary == BoundaryMode::Curve)
@@ -81,50 +83,66 @@ fn explicit_rows(ctx: &Ctx) -> Rows {
 }
 
 /// The explicit operator: general normalised rows, or the umbrella (uniform weights, no curve
-/// rows), whose off-diagonal entries are all −1/valence, so only column indices are read.
-enum Rows {
+/// rows) read straight from the stencil's pattern: its off-diagonal entries are all −1/valence,
+/// so only column indices are read (half the memory traffic of a valued matrix).
+enum Rows<'a> {
     General(Csr),
-    Umbrella { pattern: Csr, inv_deg: Vec<f64> },
+    Umbrella(&'a Csr),
 }
 
-/// `out_i = x_i − f·w_i·(R x)_i` for moving vertices (Jacobi update into a second buffer, so one
-/// pass over the matrix and the positions per step).
-fn explicit_step(ctx: &Ctx, rows: &Rows, x: &[Point3], out: &mut [Point3], f: f64) {
+/// Per-vertex step gain (soft weight, 0 for fixed vertices); `None` when every vertex moves with
+/// weight 1, so the common case reads nothing per vertex but the positions and the rows.
+fn explicit_gain(ctx: &Ctx) -> Option<Vec<f64>> {
     let (moving, w) = (&ctx.free.moving, &ctx.free.weight);
+    if moving.iter().zip(w).all(|(&m, &w)| m && w == 1.0) {
+        return None;
+    }
+    Some(moving.iter().zip(w).map(|(&m, &w)| if m { w } else { 0.0 }).collect())
+}
+
+/// `out_i = x_i − f·g_i·(R x)_i` (Jacobi update into a second buffer, so one pass over the rows
+/// and the positions per step); `g` = [`explicit_gain`].
+fn explicit_step(rows: &Rows, gain: Option<&[f64]>, x: &[Point3], out: &mut [Point3], f: f64) {
     let kernel = |(i, o): (usize, &mut Point3)| {
         let xi = x[i];
-        if !moving[i] {
+        let g = gain.map_or(1.0, |g| g[i]);
+        if g == 0.0 {
             *o = xi;
             return;
         }
-        let mut acc = [0.0f64; 3];
+        let s = f * g;
         match rows {
             Rows::General(r) => {
                 let (a, b) = (r.row_ptr[i] as usize, r.row_ptr[i + 1] as usize);
+                let mut acc = [0.0f64; 3];
                 for (&j, &v) in r.col[a..b].iter().zip(&r.val[a..b]) {
                     let xj = x[j as usize];
                     acc[0] += v * xj[0];
                     acc[1] += v * xj[1];
                     acc[2] += v * xj[2];
                 }
+                *o = [xi[0] - s * acc[0], xi[1] - s * acc[1], xi[2] - s * acc[2]];
             }
-            Rows::Umbrella { pattern, inv_deg } => {
-                let (a, b) = (pattern.row_ptr[i] as usize, pattern.row_ptr[i + 1] as usize);
-                for &j in &pattern.col[a..b] {
+            Rows::Umbrella(p) => {
+                let (a, b) = (p.row_ptr[i] as usize, p.row_ptr[i + 1] as usize);
+                let valence = (b - a - 1) as f64; // the row holds the diagonal too
+                if valence == 0.0 {
+                    *o = xi;
+                    return;
+                }
+                let mut acc = [0.0f64; 3];
+                for &j in &p.col[a..b] {
                     let xj = x[j as usize];
                     acc[0] += xj[0];
                     acc[1] += xj[1];
                     acc[2] += xj[2];
                 }
-                // The sum included x_i itself (the diagonal is in the pattern).
-                let s = inv_deg[i];
-                for k in 0..3 {
-                    acc[k] = xi[k] - s * (acc[k] - xi[k]);
-                }
+                // (R x)_i = x_i − mean of the neighbours; the sum included x_i itself.
+                let t = s / valence;
+                let c = 1.0 - s - t;
+                *o = [c * xi[0] + t * acc[0], c * xi[1] + t * acc[1], c * xi[2] + t * acc[2]];
             }
         }
-        let s = f * w[i];
-        *o = [xi[0] - s * acc[0], xi[1] - s * acc[1], xi[2] - s * acc[2]];
     };
     if x.len() >= 20_000 {
         out.par_iter_mut().enumerate().with_min_len(4096).for_each(kernel);

@@ -8,6 +8,7 @@
 //! eq. 3-8/4-2 (`I − λL` with a PSD `L`) is fixed by construction.
 
 pub mod constraints;
+pub mod highlight;
 mod methods;
 pub mod params;
 pub mod system;
@@ -18,7 +19,7 @@ pub use params::{BoundaryMode, Method, SmoothParams};
 
 use crate::error::{Error, Result};
 use crate::job::{Output, Progress, Stages};
-use crate::laplacian::{self, MassKind, Operator, OperatorKind, Stencil};
+use crate::laplacian::{self, Operator, Stencil};
 use crate::mesh::{Mesh, Point3};
 use crate::metrics;
 use params::Resolved;
@@ -67,6 +68,9 @@ impl Ctx<'_> {
 
 /// Runs the smooth job on `mesh`.
 pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Output> {
+    if params.method == Method::Highlight {
+        return highlight::run(mesh, params, progress);
+    }
     let r = params.resolve()?;
     let mut stages = Stages::new();
     if mesh.faces.is_empty() {
@@ -77,7 +81,12 @@ pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Out
     }
     let n = mesh.vertex_count();
     let (stencil, op) = stages.run(progress, "assemble", || {
-        let st = Stencil::new(&mesh.faces, n, laplacian::layout_for(r.operator, &mesh.faces))?;
+        // The umbrella needs no per-pair weights: its stencil is the cheap topological one.
+        let st = if r.operator == laplacian::OperatorKind::Uniform {
+            Stencil::uniform(&mesh.faces, n)?
+        } else {
+            Stencil::new(&mesh.faces, n, laplacian::layout_for(r.operator, &mesh.faces))?
+        };
         let op = laplacian::assemble(&mesh.positions, &mesh.faces, &st, r.operator, r.mass);
         Ok((st, op))
     })?;
@@ -109,7 +118,9 @@ pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Out
     let obj = report.as_object_mut().ok_or_else(|| Error::Internal("report".into()))?;
     obj.insert("total_ms".into(), json!(stages.total_ms()));
     obj.insert("stages".into(), stages.to_json());
-    let mut out = mesh.clone();
+    drop(ctx);
+    // The input is ours: hand it back with the new positions (no copy of the faces).
+    let mut out = mesh;
     if out.normals.is_some() {
         out.normals = Some(vertex_normals(&x, &out));
     }
@@ -148,16 +159,12 @@ fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
     let x0 = &mesh.positions;
     let f = &mesh.faces;
     let (max_d, mean_d) = metrics::displacement(x0, x);
-    let a0 = metrics::angle_stats(x0, f);
-    let a1 = metrics::angle_stats(x, f);
-    let vol1 = metrics::volume_about(x, f, ctx.center);
-    let (area0, area1) = (metrics::area(x0, f), metrics::area(x, f));
-    let curvature = |p: &[Point3]| {
-        laplacian::operator(p, f, OperatorKind::Cotan, MassKind::Voronoi)
-            .map(|op| metrics::mean_curvature(&op, p, &ctx.boundary))
-            .unwrap_or(f64::NAN)
-    };
-    let (h0, h1) = rayon::join(|| curvature(x0), || curvature(x));
+    // One fused pass over the triangles for both states (areas, volume, angles, flips, curvature).
+    let q = metrics::compare(x0, x, f, ctx.center, &ctx.boundary);
+    let (a0, a1) = (q.before.angles, q.after.angles);
+    let vol1 = q.after.volume;
+    let (area0, area1) = (q.before.area, q.after.area);
+    let (h0, h1) = (q.before.mean_curvature, q.after.mean_curvature);
     let hausdorff =
         if ctx.r.hausdorff { Some(crate::spatial::hausdorff_vertices(x0, f, x, f)) } else { None };
     let diag = crate::geometry::Aabb::of(x0).map(|b| b.diagonal()).unwrap_or(0.0);
@@ -191,7 +198,7 @@ fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
         "mean_min_angle_after": a1.mean_min,
         "max_angle_before": a0.max,
         "max_angle_after": a1.max,
-        "flipped_faces": metrics::flipped_faces(x0, x, f),
+        "flipped_faces": q.flipped_faces,
         "mean_curvature_before": h0,
         "mean_curvature_after": h1,
         "solver": ctx.solver,

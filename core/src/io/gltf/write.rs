@@ -40,6 +40,7 @@ fn unit_f32(n: [f64; 3]) -> [f32; 3] {
 fn triangles_by_group(mesh: &Mesh) -> Result<Vec<Vec<u32>>> {
     let group_count = mesh.faces.groups().iter().map(|&g| g as usize + 1).max().unwrap_or(0);
     let mut by_group = vec![Vec::new(); group_count.max(mesh.groups.len())];
+    let apex = mesh.faces.fan_apexes();
     for (fi, face) in mesh.faces.iter().enumerate() {
         if face.len() < 3 {
             return Err(Error::InvalidMesh {
@@ -48,9 +49,7 @@ fn triangles_by_group(mesh: &Mesh) -> Result<Vec<Vec<u32>>> {
             });
         }
         let tris = &mut by_group[mesh.faces.group(fi) as usize];
-        for k in 1..face.len() - 1 {
-            tris.extend_from_slice(&[face[0], face[k], face[k + 1]]);
-        }
+        crate::mesh::fan_of(face, apex[fi] as usize, |t| tris.extend_from_slice(&t));
     }
     Ok(by_group)
 }
