@@ -27,7 +27,11 @@ fn network(h: f64) -> Mesh {
             1.0,
             vec![0.0, PI / 6.0, FRAC_PI_2, 5.0 * PI / 6.0, PI, 3.0 * FRAC_PI_2],
         ),
-        (Box::new(move |t: f64| [r * t.cos(), r * t.sin(), 0.5]), r, vec![0.0, FRAC_PI_2, PI, 3.0 * FRAC_PI_2]),
+        (
+            Box::new(move |t: f64| [r * t.cos(), r * t.sin(), 0.5]),
+            r,
+            vec![0.0, FRAC_PI_2, PI, 3.0 * FRAC_PI_2],
+        ),
     ];
     let mut positions = Vec::new();
     let mut curves = Vec::new();
@@ -74,7 +78,8 @@ fn curves_five_times_denser_than_the_template() {
         .faces
         .iter()
         .filter(|f| {
-            let (a, b, c) = (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
+            let (a, b, c) =
+                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
             dot(triangle_cross(a, b, c), [a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]]) <= 0.0
         })
         .count();
