@@ -155,3 +155,35 @@ fn uvs_are_carried_to_new_vertices() {
     let read = meshwork_core::io::read(&bytes, &Default::default()).unwrap().mesh;
     assert_eq!(read.uvs.as_ref().map(|u| u.len()), Some(m.vertex_count()));
 }
+
+/// The template's face groups survive as region × group: the grid's left half is group "left",
+/// the right half "right"; the line and the circle (which straddles x = 1/2) make 3 regions, each
+/// on both halves: 6 output groups, and every output face lying in one half carries that half's
+/// name (hand truth from its corner positions; no smoothing, so nothing moves afterwards).
+#[test]
+fn template_groups_are_intersected_with_regions() {
+    let g = grid(24, 24, 1.0 / 24.0, false);
+    let tris: Vec<[u32; 3]> = g.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let mut faces = meshwork_core::mesh::Faces::new();
+    for t in &tris {
+        let cx = t.iter().map(|&v| g.positions[v as usize][0]).sum::<f64>() / 3.0;
+        faces.push(t, (cx > 0.5) as u32);
+    }
+    let mut template = Mesh::new(g.positions.clone(), faces);
+    template.groups = vec!["left".into(), "right".into()];
+    let params = FitParams { smooth: false, ..params() };
+    let out = run(vec![template, curves()], &params, &Progress::new()).unwrap();
+    assert_eq!(out.report["regions"], 3);
+    let m = &out.meshes[0];
+    assert_eq!(m.groups.len(), 6, "{:?}", m.groups);
+    for (i, f) in m.faces.iter().enumerate() {
+        let xs: Vec<f64> = f.iter().map(|&v| m.positions[v as usize][0]).collect();
+        let name = m.group_name(m.faces.group(i));
+        if xs.iter().all(|&x| x <= 0.5) && xs.iter().any(|&x| x < 0.5) {
+            assert!(name.ends_with("/left"), "face {i} at x {xs:?} is in {name}");
+        }
+        if xs.iter().all(|&x| x >= 0.5) && xs.iter().any(|&x| x > 0.5) {
+            assert!(name.ends_with("/right"), "face {i} at x {xs:?} is in {name}");
+        }
+    }
+}
