@@ -392,3 +392,51 @@ fn beetle_roof_is_faired_without_touching_the_rest() {
         }
     }
 }
+
+#[test]
+fn beetle_as_one_region_lowers_the_energy_without_flipping_faces() {
+    // The whole model as R (the paper warns large regions may fail; the safeguards must hold):
+    // the 33 pieces' boundaries act as R's border.
+    let m = beetle();
+    let out = smooth(
+        &m,
+        json!({"method": "highlight", "region_all": true, "light_normal": [0, 1, 0],
+                                "light_direction": [0, 0, 1]}),
+    );
+    let r = &out.report;
+    assert_eq!(r["flipped_faces"], 0);
+    assert!(r["movable_vertices"].as_u64().unwrap() > 100);
+    assert!(r["willmore_after"].as_f64() < r["willmore_before"].as_f64());
+    let (d0, d1) = (&r["highlight_deviation_before"], &r["highlight_deviation_after"]);
+    assert!(d1["f_diff"].as_f64() < d0["f_diff"].as_f64());
+    assert!(r["max_step_bound_use"].as_f64().unwrap() <= 1.0 + 1e-12);
+}
+
+#[test]
+fn the_result_does_not_depend_on_the_model_scale() {
+    // f_diff is measured in units of e³ so ω₁ = ω₂ = 1 means the same at any scale: the bumped
+    // cylinder at ×1e-3 (lights scaled alike) must give the same relative numbers.
+    let (mut m, uv) = cylinder(24, 20);
+    bump(&mut m, &uv, 0.02, 0.25);
+    let region = disc(&uv, 0.8);
+    let s = 1e-3;
+    let mut small = m.clone();
+    for p in &mut small.positions {
+        *p = p.map(|c| c * s);
+    }
+    let a =
+        smooth(&m, with(axis_lights(), json!({"method": "highlight", "region": region, "iterations": 5})));
+    let b = smooth(
+        &small,
+        json!({"method": "highlight", "region": region, "iterations": 5, "light_normal": [0, 0, 1],
+               "light_direction": [1, 0, 0], "light_origin": [0, 0, 3.0 * s], "light_spacing": 0.25 * s}),
+    );
+    for k in ["mean_distance_relative", "max_distance_relative", "f_diff_relative"] {
+        let (x, y) = (
+            a.report["highlight_deviation_after"][k].as_f64().unwrap(),
+            b.report["highlight_deviation_after"][k].as_f64().unwrap(),
+        );
+        assert!((x - y).abs() <= 1e-6 * x.abs().max(1e-12), "{k}: {x} vs {y}");
+    }
+    assert_eq!(a.report["iterations"], b.report["iterations"]);
+}

@@ -12,7 +12,8 @@
 //!   different balance at every model scale.
 //! - A step is accepted only if the true (non-approximated) target decreased; otherwise it is
 //!   halved, up to `MAX_HALVINGS` times, and iterations stop when no halving helps. A step that
-//!   would flip a triangle is halved the same way (the ½-edge bound does not rule flips out).
+//!   would flip a triangle (turn its normal by more than 90° from the previous step or from the
+//!   input) is halved the same way (the ½-edge bound does not rule flips out).
 //! - `f_fair` keeps the printed eq. 8 (`1/Aᵢ`, not `1/(2Aᵢ)`), so `‖K‖² = 16H²`.
 
 use crate::error::Result;
@@ -446,7 +447,9 @@ pub fn iterate(
         let mut halvings = 0;
         for h in 0..=MAX_HALVINGS {
             let trial = moved(&x, &nrm, setup, &step, scale_f);
-            if flips(adj, &x, &trial, setup) {
+            // Against the previous step and against the input: a face may not turn by more than
+            // 90° in one step nor accumulate that over several.
+            if flips(adj, &x, &trial, setup) || flips(adj, x0, &trial, setup) {
                 out.flips_prevented += 1;
             } else {
                 let st = State::new(adj, &trial, setup);
