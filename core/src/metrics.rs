@@ -290,18 +290,40 @@ impl TriAcc {
         self.sum_min_angle += tw.atan2(dmax);
         self.max_cot = self.max_cot.max(cot_key(dmax, tw));
         self.min_cot = self.min_cot.min(cot_key(dmin, tw));
-        // Cotangent Laplacian and Voronoi mass, with the operator's own per-triangle terms.
-        let (cot, vor, _, _) = crate::laplacian::triangle_terms(p);
+        // Cotangent Laplacian (S x) and Voronoi mass: `laplacian::triangle_terms` from the dots
+        // already at hand (cot_q = d_q / tw; same degeneracy rule and Voronoi split).
+        let l2 = [dot(e12, e12), dot(e02, e02), dot(e01, e01)]; // edge opposite corner q
+        let lmax2 = l2[0].max(l2[1]).max(l2[2]);
+        let area = 0.5 * tw;
         let v = [i, j, k];
-        for q in 0..3 {
-            let (a, b) = (v[(q + 1) % 3], v[(q + 2) % 3]);
-            let w = 0.5 * cot[q];
-            let dx = sub(p[(q + 1) % 3], p[(q + 2) % 3]);
-            for r in 0..3 {
-                self.hm[a][r] += w * dx[r];
-                self.hm[b][r] -= w * dx[r];
+        if !(tw > crate::laplacian::DEGENERATE_SHAPE * lmax2) {
+            for q in 0..3 {
+                self.hm[v[q]][3] += area / 3.0;
             }
-            self.hm[v[q]][3] += vor[q];
+            return c;
+        }
+        let inv = 1.0 / tw;
+        let cot = [d[0] * inv, d[1] * inv, d[2] * inv];
+        let obtuse = dmin < 0.0;
+        for q in 0..3 {
+            let (a, b) = ((q + 1) % 3, (q + 2) % 3);
+            // ½Σ cot(opposite)·(x_q − x_other) over the two edges at corner q.
+            let (wa, wb) = (0.5 * cot[b], 0.5 * cot[a]);
+            let (da, db) = (sub(p[q], p[a]), sub(p[q], p[b]));
+            let vor = if obtuse {
+                if cot[q] < 0.0 {
+                    area / 2.0
+                } else {
+                    area / 4.0
+                }
+            } else {
+                (l2[a] * cot[a] + l2[b] * cot[b]) / 8.0
+            };
+            let h = &mut self.hm[v[q]];
+            h[0] += wa * da[0] + wb * db[0];
+            h[1] += wa * da[1] + wb * db[1];
+            h[2] += wa * da[2] + wb * db[2];
+            h[3] += vor;
         }
         c
     }
