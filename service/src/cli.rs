@@ -77,9 +77,17 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
         pairs_from_file(&mut params)?;
     }
 
+    // `meshwork morph A B -o frames.zip`: the frames as separate files (GLB unless
+    // `--frames-zip obj`), zipped; the job's first artifact is then the ZIP.
+    let zip_out = kind == JobKind::Morph
+        && args.format.is_none()
+        && args.output.as_ref().is_some_and(|o| o.to_string_lossy().to_ascii_lowercase().ends_with(".zip"));
+    if zip_out && !params.contains_key("frames_zip") {
+        params.insert("frames_zip".into(), Value::String("glb".into()));
+    }
     let out_format = if kind.returns_mesh() {
         let out = args.output.as_ref().ok_or_else(|| Failure::usage("error[usage]: -o OUT is required"))?;
-        Some(output_format(out, args.format.as_deref())?)
+        Some(if zip_out { Format::Glb } else { output_format(out, args.format.as_deref())? })
     } else {
         if args.output.is_some() {
             return Err(Failure::usage("error[usage]: `info` writes no mesh; use --report for the report"));
@@ -123,7 +131,10 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
     let mut mesh_to_stdout = false;
     if let (Some(format), Some(out)) = (out_format, &args.output) {
         let (bytes, media_type, _) = runner::encode(&done.output, format)?;
-        if !done.output.artifacts.is_empty() && media_type != format.mime() {
+        if !done.output.artifacts.is_empty()
+            && media_type != format.mime()
+            && !(zip_out && media_type == "application/zip")
+        {
             eprintln!("warning: {} produces {media_type}; writing that to {}", kind.name(), out.display());
         }
         if out == Path::new("-") {

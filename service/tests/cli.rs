@@ -270,3 +270,55 @@ fn fit_takes_polylines_json_and_a_pairs_file() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("polylines[0][1]"), "{}", stderr(&o));
 }
+
+/// Entries of a ZIP by its end-of-central-directory record (no comment: the last 22 bytes).
+fn zip_entries(b: &[u8]) -> u16 {
+    assert!(b.len() >= 22 && b[..4] == [0x50, 0x4b, 0x03, 0x04], "not a ZIP");
+    let end = &b[b.len() - 22..];
+    assert_eq!(end[..4], [0x50, 0x4b, 0x05, 0x06], "no end record");
+    u16::from_le_bytes([end[10], end[11]])
+}
+
+#[test]
+fn morph_to_a_zip_writes_one_file_per_frame() {
+    // Two open meshes (woody and alligator are disks): the planar path, frames zipped as GLB.
+    let out = tmp("frames.zip");
+    let o = run(&[
+        "morph",
+        shared_mesh("woody.obj").to_str().unwrap(),
+        shared_mesh("alligator.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--frames",
+        "3",
+        "--report",
+        tmp("frames-report.json").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let z = std::fs::read(&out).unwrap();
+    assert_eq!(zip_entries(&z), 3);
+    // The first entry is frame_0000.glb and holds a GLB (local header 30 bytes + name).
+    assert_eq!(&z[30..44], b"frame_0000.glb");
+    assert_eq!(&z[44..48], b"glTF");
+    let rep: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(tmp("frames-report.json")).unwrap()).unwrap();
+    assert_eq!(rep["domain"], "planar");
+    assert_eq!(rep["frames_zip"], "glb");
+    // `--frames-zip obj` picks OBJ frames.
+    let o = run(&[
+        "morph",
+        shared_mesh("woody.obj").to_str().unwrap(),
+        shared_mesh("alligator.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--frames",
+        "2",
+        "--frames-zip",
+        "obj",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let z = std::fs::read(&out).unwrap();
+    assert_eq!(zip_entries(&z), 2);
+    assert_eq!(&z[30..44], b"frame_0000.obj");
+}

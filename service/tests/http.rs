@@ -448,6 +448,16 @@ fn morph_answers_its_animated_glb_and_refuses_genus_one() {
     assert!(p["detail"].as_str().unwrap().contains("genus"), "{p}");
     // Only one input.
     s.post_multipart("/v1/morph", &[file_part("mesh", "a.obj", &a)]).problem(422, "invalid-params");
+    // The frames as separate OBJ files in a ZIP.
+    let r = s.post_multipart(
+        "/v1/morph?frames=3&frames_zip=obj",
+        &[file_part("mesh", "a.obj", &a), file_part("mesh", "b.obj", &b)],
+    );
+    assert_eq!(r.status, 200, "{}", r.text());
+    assert_eq!(r.header("content-type"), Some("application/zip"));
+    assert_eq!(&r.body[..4], b"PK\x03\x04");
+    let end = &r.body[r.body.len() - 22..];
+    assert_eq!(u16::from_le_bytes([end[10], end[11]]), 3, "three frames");
 }
 
 /// A wavy line across the unit square and a closed circle, as OBJ `l` polylines (the curves of

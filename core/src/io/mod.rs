@@ -11,6 +11,7 @@ pub mod obj;
 pub mod off;
 pub mod ply;
 pub mod stl;
+pub mod zip;
 
 /// Formats we read and write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]

@@ -19,7 +19,12 @@ pub mod correspond;
 pub mod glb;
 pub mod interpolate;
 pub mod metamesh;
+pub mod output;
 pub mod param;
+pub mod planar;
+pub mod planar_job;
+pub mod plane_overlay;
+pub mod pseudo;
 pub mod report;
 pub mod simplify;
 pub mod trimesh;
@@ -70,6 +75,10 @@ pub enum Correspondence {
     /// Input 0's connectivity carried onto the others by barycentric coordinates (smaller output,
     /// the other inputs only approximated).
     Transfer,
+    /// Seed 002's adaptive pseudo-metamesh: the target's embedding split 1-to-4 until each
+    /// triangle holds at most one source vertex (the target reproduced exactly, the source
+    /// approximated; usually fewer vertices than the overlay).
+    Pseudo,
 }
 
 /// Parameters of the morph job.
@@ -108,6 +117,14 @@ pub struct MorphParams {
     pub output_frames: bool,
     /// Refuse inputs with more vertices than this (each).
     pub max_vertices: usize,
+    /// Also return the frames as separate files in a ZIP (stored, one `frame_NNNN.glb` or
+    /// `.obj` per frame) as the job's result file (`application/zip`); the animated GLB follows
+    /// as the second artifact.
+    pub frames_zip: Option<output::FrameFormat>,
+    /// Interior weights of the planar (disk) parameterisation.
+    pub planar_method: planar::PlanarMethod,
+    /// `correspondence: pseudo`: most 1-to-4 subdivision levels per target triangle.
+    pub pseudo_max_depth: u32,
 }
 
 impl Default for MorphParams {
@@ -129,6 +146,9 @@ impl Default for MorphParams {
             blend_weights: None,
             output_frames: false,
             max_vertices: 2_000_000,
+            frames_zip: None,
+            planar_method: planar::PlanarMethod::Elrp,
+            pseudo_max_depth: 8,
         }
     }
 }
@@ -146,6 +166,9 @@ impl MorphParams {
         }
         if !(self.support_radius > 0.0 && self.support_radius <= 2.0) {
             return Err(Error::params("support_radius", "must be in (0, 2]"));
+        }
+        if self.pseudo_max_depth > 16 {
+            return Err(Error::params("pseudo_max_depth", "must be ≤ 16"));
         }
         if self.feature_steps == 0 || self.feature_steps > 1000 {
             return Err(Error::params("feature_steps", "must be 1..=1000"));
@@ -184,6 +207,10 @@ fn input_name(k: usize) -> String {
 /// Inputs: 2..16 meshes (source, target, more for a multi-morph).
 pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Result<Output> {
     params.check(inputs.len())?;
+    // Disk-like inputs take the planar domain.
+    if let Some(out) = planar_job::dispatch(&inputs, params, progress)? {
+        return Ok(out);
+    }
     let k_in = inputs.len();
     let mut stages = Stages::new();
 
@@ -325,7 +352,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             .collect();
         let mut icp = Vec::new();
         if params.registration == Registration::PcaIcp {
-            let target = register::surface::SurfaceIndex::new(&norm[0].pos, &norm[0].tris);
+            let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
             for k in 1..k_in {
                 progress.fraction(k as f64 / k_in as f64)?;
                 let r = register::icp(&norm[k].pos, &target, 50);
@@ -387,7 +414,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     }
 
     // 5. Correspondence: chain overlays (or transfers) through the inputs.
-    let (layer, overlay_reps, fallback) = stages.run(progress, "metamesh", || {
+    let (layer, overlay_reps, fallback, pseudo_reps) = stages.run(progress, "metamesh", || {
         let layers: Vec<Layer> = normalised
             .iter()
             .zip(&spheres)
@@ -396,6 +423,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         let mut acc = layers[0].clone();
         let mut reps = Vec::new();
         let mut fallback: Option<String> = None;
+        let mut pseudo_reps = Vec::new();
         for l in &layers[1..] {
             acc = match params.correspondence {
                 Correspondence::Overlay => match metamesh::overlay(&acc, l, progress) {
@@ -410,9 +438,15 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
                     Err(e) => return Err(e),
                 },
                 Correspondence::Transfer => metamesh::transfer(&acc, l, progress)?,
+                Correspondence::Pseudo => {
+                    let (p, r) =
+                        pseudo::pseudo(&acc, l, pseudo::Domain::Sphere, params.pseudo_max_depth, progress)?;
+                    pseudo_reps.push(r);
+                    p
+                }
             };
         }
-        Ok((acc, reps, fallback))
+        Ok((acc, reps, fallback, pseudo_reps))
     })?;
 
     // 6. Interpolate, in input 0's coordinates.
@@ -438,8 +472,16 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     // 7. GLB.
     let glb_bytes = stages.run(progress, "glb", || {
         let keys = interpolate::keyframes(params.frames, k_in, params.duration_seconds);
-        Ok(glb::write(&layer.tris, &shapes_out, &keys))
+        glb::write(&layer.tris, &shapes_out, &keys)
     })?;
+    let mut artifacts =
+        vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }];
+    if let Some(fmt) = params.frames_zip {
+        let z = stages.run(progress, "frames_zip", || {
+            output::frames_zip(&layer.tris, &shapes_out, params.frames, fmt, progress)
+        })?;
+        artifacts.insert(0, z);
+    }
 
     // 8. Report: how well the end frames reproduce the inputs (in the normalised frames).
     let hausdorff = stages.run(progress, "report", || {
@@ -451,7 +493,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
                     &normalised[k].pos,
                     &normalised[k].tris,
                     // Overlay faces lie inside input faces: their vertices bound the distance.
-                    overlay_reps.len() + 1 < k_in || params.correspondence == Correspondence::Transfer,
+                    overlay_reps.len() + 1 < k_in || params.correspondence != Correspondence::Overlay,
                 )
             })
             .collect::<Vec<f64>>())
@@ -479,11 +521,15 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "metamesh_faces": layer.tris.len(),
         "correspondence": match (params.correspondence, &fallback) {
             (Correspondence::Transfer, _) => "transfer",
+            (Correspondence::Pseudo, _) => "pseudo",
             (_, Some(_)) => "transfer_fallback",
             _ => "overlay",
         },
         "correspondence_fallback": fallback,
         "overlays": overlay_reps,
+        "pseudo_metamesh": pseudo_reps,
+        "domain": "spherical",
+        "frames_zip": params.frames_zip,
         "hausdorff_first_frame": hausdorff[0],
         "hausdorff_last_frame": hausdorff[k_in - 1],
         "hausdorff_per_input": hausdorff,
@@ -496,13 +542,5 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "total_ms": stages.total_ms(),
         "stages": stages.to_json(),
     });
-    Ok(Output {
-        meshes: out_meshes,
-        artifacts: vec![Artifact {
-            name: "morph.glb".into(),
-            media_type: "model/gltf-binary".into(),
-            bytes: glb_bytes,
-        }],
-        report,
-    })
+    Ok(Output { meshes: out_meshes, artifacts, report })
 }

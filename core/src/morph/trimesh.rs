@@ -274,7 +274,17 @@ pub fn require_sphere_like(info: &TopologyInfo, which: &str) -> Result<()> {
         problems.push(format!("{} non-manifold vertices", info.non_manifold_vertices));
     }
     if info.boundary_loops > 0 {
-        problems.push(format!("open: {} boundary loops", info.boundary_loops));
+        // χ = 2 − 2g − b for a connected manifold surface with b boundary loops.
+        let g = 2 - info.boundary_loops as i64 - info.euler_characteristic;
+        if problems.is_empty() && g % 2 == 0 {
+            problems.push(format!(
+                "an open surface of genus {} with {} boundary loops (the planar domain takes exactly one)",
+                g / 2,
+                info.boundary_loops
+            ));
+        } else {
+            problems.push(format!("open: {} boundary loops", info.boundary_loops));
+        }
     }
     if problems.is_empty() {
         match info.genus {
@@ -286,7 +296,8 @@ pub fn require_sphere_like(info: &TopologyInfo, which: &str) -> Result<()> {
         }
     }
     Err(Error::Topology(format!(
-        "{which}: the spherical morph needs a closed, connected, manifold genus-0 mesh; found {} \
+        "{which}: the morph needs a closed, connected, manifold genus-0 mesh (spherical domain) or a \
+         disk (one boundary loop, genus 0: planar domain, decided by input 0); found {} \
          (set `repair: true` to mend holes and non-manifold parts first)",
         problems.join(", ")
     )))

@@ -40,6 +40,8 @@ pub(super) fn run(ctx: &mut Ctx) -> Result<Vec<Point3>> {
         Method::Inflate => inflate(ctx, &mut x)?,
         Method::Fair => fair(ctx, &mut x)?,
         Method::Tangential => tangential(ctx, &mut x)?,
+        // Dispatched before the shared preparation (its own pipeline: smooth::highlight).
+        Method::Highlight => return Err(Error::Internal("highlight reached the Laplacian methods".into())),
     }
     Ok(x)
 }

@@ -8,6 +8,7 @@
 //! eq. 3-8/4-2 (`I − λL` with a PSD `L`) is fixed by construction.
 
 pub mod constraints;
+pub mod highlight;
 mod methods;
 pub mod params;
 pub mod system;
@@ -67,6 +68,9 @@ impl Ctx<'_> {
 
 /// Runs the smooth job on `mesh`.
 pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Output> {
+    if params.method == Method::Highlight {
+        return highlight::run(mesh, params, progress);
+    }
     let r = params.resolve()?;
     let mut stages = Stages::new();
     if mesh.faces.is_empty() {

@@ -27,6 +27,10 @@ pub enum Method {
     /// Seed 000 tangential flows: modified mean-curvature flow (tangential, projected back onto the
     /// current surface) then modified Laplacian flow (tangential, projected onto the input).
     Tangential,
+    /// Seed 001 highlight-line fairing of a region (`region`, `region_faces`, `groups` or
+    /// `region_all`): vertices move along their normals, each step a bound-constrained QP trading
+    /// Willmore energy against the distance of the highlight lines to smooth (OGH) desired lines.
+    Highlight,
 }
 
 /// What boundary vertices of open meshes do.
@@ -106,6 +110,36 @@ pub struct SmoothParams {
     /// Compute the symmetric Hausdorff distance for the report (default true; costs two
     /// closest-point passes).
     pub hausdorff: Option<bool>,
+    /// `highlight`: faces whose vertices form the region R (with `region`/`groups`).
+    pub region_faces: Vec<u32>,
+    /// `highlight`: R = every vertex (the mesh boundary then acts as R's border).
+    pub region_all: bool,
+    /// `highlight`: unit normal Z of the light plane (default: area-weighted mean normal of R).
+    #[schema(value_type = Option<Vec<f64>>)]
+    pub light_normal: Option<[f64; 3]>,
+    /// `highlight`: direction H of the linear lights, in the light plane (default: the coordinate
+    /// axis along which R is longest, projected into the plane).
+    #[schema(value_type = Option<Vec<f64>>)]
+    pub light_direction: Option<[f64; 3]>,
+    /// `highlight`: a point A₀ on the base light L₀ (default: centre of R's bounding box moved
+    /// one box diagonal along the light normal).
+    #[schema(value_type = Option<Vec<f64>>)]
+    pub light_origin: Option<[f64; 3]>,
+    /// `highlight`: distance s between neighbouring lights (default: the 5th–95th percentile
+    /// range of the highlight distance over R / 16, i.e. about 16 lines across R).
+    pub light_spacing: Option<f64>,
+    /// `highlight`: ε of eq. 17, stop when max |xᵢ| / (mean edge length in R) < ε (default 0.001).
+    pub convergence_threshold: Option<f64>,
+    /// `highlight`: ω₁, weight of the Willmore (fairness) energy (default 1).
+    pub fairness_weight: Option<f64>,
+    /// `highlight`: ω₂, weight of the highlight-line difference energy (default 1).
+    pub highlight_weight: Option<f64>,
+    /// `highlight`: bound on each step as a fraction of the shortest incident edge (default and
+    /// maximum 0.5, the paper's).
+    pub max_step_fraction: Option<f64>,
+    /// `highlight`: include the highlight lines before and after (polylines per light index) in the
+    /// report under `highlight_lines`.
+    pub highlight_lines: bool,
 }
 
 /// Hard cap on iterations (every loop has one).
@@ -149,6 +183,7 @@ impl SmoothParams {
             Method::Laplacian | Method::Taubin | Method::Tangential => 10,
             Method::Implicit | Method::Inflate | Method::Fair => 1,
             Method::Mcf => 5,
+            Method::Highlight => super::highlight::DEFAULT_ITERATIONS,
         });
         if iterations > MAX_ITERATIONS {
             return Err(Error::params("iterations", format!("at most {MAX_ITERATIONS}")));

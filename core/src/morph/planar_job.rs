@@ -1,0 +1,414 @@
+//! The morph pipeline on the planar domain, for disk-like inputs (one boundary loop, genus 0).
+//!
+//! Stages (each timed): `validate` (every input a disk) → `normalise` (as the spherical path:
+//! PCA frame, optional ICP; then each input's faces oriented so its mean normal is +z in its
+//! normalised frame, which makes the boundary correspondences of all inputs of one handedness) →
+//! `parameterise` ([`super::planar`]: ELRP, Tutte fallback, flip check) → `align_features`
+//! (boundary rotation onto input 0, then the planar CTPS C²a warp) → `common_boundary` →
+//! `metamesh` (planar overlay, or the pseudo-metamesh / transfer) → `interpolate` → `glb`
+//! (→ `frames_zip`) → `report`.
+//!
+//! `repair` is not applied on this path: a disk that needs repair (holes, non-manifold parts) is
+//! not recognised as a disk, and the spherical path's repair closes holes.
+
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, triangle_cross};
+use crate::job::{Artifact, Output, Progress, Stages};
+use crate::mesh::{Mesh, Point3};
+use crate::register::{self, Similarity};
+
+use super::metamesh::{self, Layer};
+use super::planar::{self, DiskMap};
+use super::plane_overlay::{self, DiskLayer};
+use super::pseudo::{self, Domain};
+use super::trimesh::{self, TriMesh};
+use super::{glb, input_name, interpolate, output, report, Correspondence, MorphParams, Registration};
+
+/// Runs the planar pipeline when input 0 is a disk; `None` sends the job to the spherical path.
+pub fn dispatch(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Option<Output>> {
+    let Some(first) = inputs.first() else { return Ok(None) };
+    if first.positions.len() > params.max_vertices {
+        return Ok(None); // the spherical path reports the limit
+    }
+    let (t, _, _) = TriMesh::from_mesh(first);
+    if !planar::is_disk(&trimesh::topology(&t)) {
+        return Ok(None);
+    }
+    run(inputs, params, progress).map(Some)
+}
+
+fn orient_up(m: &mut TriMesh) -> bool {
+    let n = m.tris.iter().fold([0.0; 3], |s, t| {
+        add(s, triangle_cross(m.pos[t[0] as usize], m.pos[t[1] as usize], m.pos[t[2] as usize]))
+    });
+    if n[2] < 0.0 {
+        for t in &mut m.tris {
+            t.swap(1, 2);
+        }
+        true
+    } else {
+        false
+    }
+}
+
+pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Output> {
+    let k_in = inputs.len();
+    let mut stages = Stages::new();
+
+    // 1. Validate: every input a disk.
+    let (meshes, maps, conv, topo) = stages.run(progress, "validate", || {
+        let (mut ms, mut maps, mut convs, mut topo) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (k, m) in inputs.iter().enumerate() {
+            if m.positions.len() > params.max_vertices {
+                return Err(Error::TooLarge {
+                    what: format!("{} vertices", input_name(k)),
+                    limit: params.max_vertices as u64,
+                    actual: m.positions.len() as u64,
+                });
+            }
+            let (t, map, c) = TriMesh::from_mesh(m);
+            let info = trimesh::topology(&t);
+            if !planar::is_disk(&info) {
+                return Err(Error::Topology(format!(
+                    "{}: input 0 is a disk, so the morph uses the planar domain and every input must be a \
+                     disk (connected, manifold, one boundary loop, genus 0); found {}",
+                    input_name(k),
+                    planar::describe(&info)
+                )));
+            }
+            ms.push(t);
+            maps.push(map);
+            convs.push(c);
+            topo.push(info);
+        }
+        Ok((ms, maps, convs, topo))
+    })?;
+    let features = map_features(&params.features, &maps, k_in)?;
+
+    // 2. Normalise (as the spherical path), then orient each disk's normal to +z.
+    let (normalised, frames_out, icp_reports, flipped) = stages.run(progress, "normalise", || {
+        let mut frames: Vec<Similarity> = Vec::new();
+        for m in &meshes {
+            let f = if params.registration == Registration::None && !frames.is_empty() {
+                frames[0]
+            } else {
+                register::pca_frame(&m.pos, &m.tris).to_normalised
+            };
+            frames.push(f);
+        }
+        let mut norm: Vec<TriMesh> = meshes
+            .iter()
+            .zip(&frames)
+            .map(|(m, f)| TriMesh { pos: m.pos.iter().map(|&p| f.apply(p)).collect(), tris: m.tris.clone() })
+            .collect();
+        let mut icp = Vec::new();
+        if params.registration == Registration::PcaIcp {
+            let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
+            for k in 1..k_in {
+                progress.fraction(k as f64 / k_in as f64)?;
+                let r = register::icp(&norm[k].pos, &target, 50);
+                for p in &mut norm[k].pos {
+                    *p = r.transform.apply(*p);
+                }
+                frames[k] = r.transform.then_after(&frames[k]);
+                icp.push(r);
+            }
+        }
+        let flipped: Vec<bool> = norm.iter_mut().map(orient_up).collect();
+        Ok((norm, frames, icp, flipped))
+    })?;
+
+    // 3. Disk maps.
+    let mut disks: Vec<DiskMap> = stages.run(progress, "parameterise", || {
+        normalised
+            .par_iter()
+            .map(|m| planar::parameterise(m, params.planar_method))
+            .collect::<Result<Vec<_>>>()
+    })?;
+    let param_reports: Vec<planar::PlanarReport> = disks.iter().map(|d| d.report.clone()).collect();
+    for (k, r) in param_reports.iter().enumerate() {
+        if r.foldovers > 0 {
+            return Err(Error::numerical(
+                "parameterise",
+                format!("{}: {} flipped plane triangles remain", input_name(k), r.foldovers),
+            ));
+        }
+    }
+
+    // 4. Boundary correspondence and feature alignment.
+    let align_rep = stages.run(progress, "align_features", || {
+        let mut rep = planar::PlaneAlignReport {
+            feature_points: features.len(),
+            boundary_rotation: vec![0.0],
+            rotation_rule: if features.is_empty() { "boundary_shape" } else { "features" }.into(),
+            ..Default::default()
+        };
+        for k in 1..k_in {
+            let phi = if features.is_empty() {
+                None
+            } else {
+                let f0: Vec<u32> = features.iter().map(|f| f[0]).collect();
+                let fk: Vec<u32> = features.iter().map(|f| f[k]).collect();
+                planar::feature_rotation(&disks[0].plane, &f0, &disks[k].plane, &fk)
+            };
+            let phi = phi.unwrap_or_else(|| {
+                planar::boundary_rotation(
+                    &normalised[0].pos,
+                    &disks[0].boundary,
+                    &disks[0].angles,
+                    &normalised[k].pos,
+                    &disks[k].boundary,
+                    &disks[k].angles,
+                )
+            });
+            planar::rotate(&mut disks[k], phi);
+            rep.boundary_rotation.push(phi);
+        }
+        if !features.is_empty() {
+            let tris: Vec<&[[u32; 3]]> = normalised.iter().map(|m| &m.tris[..]).collect();
+            let (folds, steps, before, after) = planar::align_features(
+                &mut disks,
+                &tris,
+                &features,
+                params.feature_steps,
+                params.support_radius,
+                progress,
+            )?;
+            rep.foldovers = folds;
+            rep.warp_steps = steps;
+            rep.max_feature_gap_before = before;
+            rep.max_feature_gap_after = after;
+        }
+        Ok(rep)
+    })?;
+    if align_rep.foldovers > 0 {
+        return Err(Error::numerical(
+            "align_features",
+            format!("{} flipped triangles after the planar warp", align_rep.foldovers),
+        ));
+    }
+
+    // 5. Common boundary, then correspondence.
+    let common = stages.run(progress, "common_boundary", || {
+        let union = planar::union_angles(&disks);
+        let mut out = Vec::with_capacity(k_in);
+        for (k, (m, d)) in normalised.iter().zip(&disks).enumerate() {
+            let c = planar::with_common_boundary(m, d, &union)?;
+            let f = planar::foldovers(&c.plane, &c.tris);
+            if f > 0 {
+                return Err(Error::numerical(
+                    "common_boundary",
+                    format!("{}: {f} flipped triangles after inserting the common boundary", input_name(k)),
+                ));
+            }
+            let mut c = c;
+            if k > 0 {
+                planar::jitter_interior(&mut c, k as u64);
+            }
+            out.push(c);
+        }
+        Ok(out)
+    })?;
+    let (layer, overlay_reps, pseudo_reps, fallback) = stages.run(progress, "metamesh", || {
+        let layers: Vec<DiskLayer> = common
+            .iter()
+            .map(|c| DiskLayer {
+                layer: Layer { sphere: c.plane.clone(), tris: c.tris.clone(), shapes: vec![c.pos.clone()] },
+                bnd: c.bnd.clone(),
+            })
+            .collect();
+        let mut acc = layers[0].clone();
+        let (mut reps, mut preps) = (Vec::new(), Vec::new());
+        let mut fallback: Option<String> = None;
+        for l in &layers[1..] {
+            acc = match params.correspondence {
+                Correspondence::Overlay => match plane_overlay::overlay(&acc, l, progress) {
+                    Ok((o, r)) => {
+                        reps.push(r);
+                        o
+                    }
+                    Err(Error::Numerical { message, .. }) => {
+                        fallback = Some(format!("overlay failed ({message}); used the barycentric transfer"));
+                        DiskLayer { layer: metamesh::transfer(&acc.layer, &l.layer, progress)?, bnd: acc.bnd }
+                    }
+                    Err(e) => return Err(e),
+                },
+                Correspondence::Transfer => {
+                    DiskLayer { layer: metamesh::transfer(&acc.layer, &l.layer, progress)?, bnd: acc.bnd }
+                }
+                Correspondence::Pseudo => {
+                    let (p, r) = pseudo::pseudo(
+                        &acc.layer,
+                        &l.layer,
+                        Domain::Plane,
+                        params.pseudo_max_depth,
+                        progress,
+                    )?;
+                    preps.push(r);
+                    let n = p.sphere.len();
+                    DiskLayer { layer: p, bnd: vec![u32::MAX; n] }
+                }
+            };
+        }
+        Ok((acc.layer, reps, preps, fallback))
+    })?;
+    let exact = params.correspondence == Correspondence::Overlay && fallback.is_none();
+    finish(
+        stages,
+        params,
+        progress,
+        Finish {
+            layer: &layer,
+            frames_out: &frames_out,
+            normalised: &normalised,
+            exact,
+        },
+    )
+    .map(|(mut report, meshes, artifacts)| {
+        let per_input: Vec<serde_json::Value> = (0..k_in)
+            .map(|k| {
+                json!({
+                    "input": k,
+                    "vertices": meshes_len(&normalised[k]),
+                    "faces": normalised[k].tris.len(),
+                    "topology": topo[k],
+                    "preparation": {"conversion": conv[k], "orientation_flipped": flipped[k]},
+                    "parameterisation": param_reports[k],
+                    "common_boundary_vertices_inserted": common[k].inserted,
+                    "hausdorff_to_input": report["hausdorff_per_input"][k],
+                })
+            })
+            .collect();
+        let extra = json!({
+            "domain": "planar",
+            "angle_distortion": param_reports.iter().map(|r| r.angle_distortion).collect::<Vec<_>>(),
+            "area_distortion": param_reports.iter().map(|r| r.area_distortion).collect::<Vec<_>>(),
+            "foldovers": param_reports.iter().map(|r| r.foldovers).collect::<Vec<_>>(),
+            "correspondence": match (params.correspondence, &fallback) {
+                (Correspondence::Transfer, _) => "transfer",
+                (Correspondence::Pseudo, _) => "pseudo",
+                (_, Some(_)) => "transfer_fallback",
+                _ => "overlay",
+            },
+            "correspondence_fallback": fallback,
+            "overlays": overlay_reps,
+            "pseudo_metamesh": pseudo_reps,
+            "common_boundary_vertices": common[0].bnd.iter().filter(|&&b| b != u32::MAX).count(),
+            "features": align_rep,
+            "icp": icp_reports,
+            "repair": if params.repair { json!("not applied: the inputs are already disks") } else { json!([]) },
+            "per_input": per_input,
+        });
+        if let (Some(r), Some(e)) = (report.as_object_mut(), extra.as_object()) {
+            for (k, v) in e {
+                r.insert(k.clone(), v.clone());
+            }
+        }
+        Output { meshes, artifacts, report }
+    })
+}
+
+/// Feature vertices (input indices) mapped to the triangulated inputs.
+fn map_features(features: &[Vec<u32>], maps: &[Vec<u32>], k_in: usize) -> Result<Vec<Vec<u32>>> {
+    let mut out = Vec::with_capacity(features.len());
+    for (i, f) in features.iter().enumerate() {
+        let mut row = Vec::with_capacity(k_in);
+        for k in 0..k_in {
+            let v = f[k] as usize;
+            let m = maps[k].get(v).copied().unwrap_or(u32::MAX);
+            if m == u32::MAX {
+                return Err(Error::params(
+                    format!("features[{i}][{k}]"),
+                    format!("vertex {v} of {} does not exist or is used by no face", input_name(k)),
+                ));
+            }
+            row.push(m);
+        }
+        out.push(row);
+    }
+    Ok(out)
+}
+
+fn meshes_len(m: &TriMesh) -> usize {
+    m.pos.len()
+}
+
+pub(super) struct Finish<'a> {
+    pub layer: &'a Layer,
+    pub frames_out: &'a [Similarity],
+    pub normalised: &'a [TriMesh],
+    /// Every metamesh face lies inside one face of every input (true overlay).
+    pub exact: bool,
+}
+
+/// Interpolation, GLB (and frames ZIP), Hausdorff of the end frames: the common tail of the
+/// planar path. Returns (report with stages, meshes, artifacts).
+pub(super) fn finish(
+    mut stages: Stages,
+    params: &MorphParams,
+    progress: &Progress,
+    f: Finish<'_>,
+) -> Result<(serde_json::Value, Vec<Mesh>, Vec<Artifact>)> {
+    let k_in = f.normalised.len();
+    let layer = f.layer;
+    let back = f.frames_out[0].inverse();
+    let shapes_out: Vec<Vec<Point3>> =
+        layer.shapes.iter().map(|s| s.iter().map(|&p| back.apply(p)).collect()).collect();
+    let meshes = stages.run(progress, "interpolate", || {
+        let mk = |pos: Vec<Point3>| Mesh::from_triangles(pos, &layer.tris);
+        Ok(if let Some(w) = &params.blend_weights {
+            vec![mk(interpolate::blend(&shapes_out, w))]
+        } else if params.output_frames {
+            (0..params.frames)
+                .map(|j| {
+                    let (leg, t) = interpolate::frame_position(j, params.frames, k_in);
+                    mk(interpolate::frame(&shapes_out, leg, t))
+                })
+                .collect()
+        } else {
+            shapes_out.iter().map(|s| mk(s.clone())).collect()
+        })
+    })?;
+    let glb_bytes = stages.run(progress, "glb", || {
+        let keys = interpolate::keyframes(params.frames, k_in, params.duration_seconds);
+        glb::write(&layer.tris, &shapes_out, &keys)
+    })?;
+    let mut artifacts =
+        vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }];
+    if let Some(fmt) = params.frames_zip {
+        let z = stages.run(progress, "frames_zip", || {
+            output::frames_zip(&layer.tris, &shapes_out, params.frames, fmt, progress)
+        })?;
+        artifacts.insert(0, z);
+    }
+    let hausdorff = stages.run(progress, "report", || {
+        Ok((0..k_in)
+            .map(|k| {
+                report::relative_hausdorff(
+                    &layer.shapes[k],
+                    &layer.tris,
+                    &f.normalised[k].pos,
+                    &f.normalised[k].tris,
+                    !f.exact,
+                )
+            })
+            .collect::<Vec<f64>>())
+    })?;
+    let report = json!({
+        "inputs": k_in,
+        "metamesh_vertices": layer.sphere.len(),
+        "metamesh_faces": layer.tris.len(),
+        "hausdorff_first_frame": hausdorff[0],
+        "hausdorff_last_frame": hausdorff[k_in - 1],
+        "hausdorff_per_input": hausdorff,
+        "frames": params.frames,
+        "frames_zip": params.frames_zip,
+        "output_meshes": if params.blend_weights.is_some() { "blend" } else if params.output_frames { "frames" } else { "remeshed_inputs" },
+        "total_ms": stages.total_ms(),
+        "stages": stages.to_json(),
+    });
+    Ok((report, meshes, artifacts))
+}
