@@ -1,9 +1,10 @@
 //! Morph benchmark and experiment driver.
 //!
-//! `bench_morph [SOURCE TARGET [MORE…]] [--dense] [--params JSON] [--out OUT.glb]`
+//! `bench_morph [SOURCE TARGET [MORE…]] [--dense | --centroid] [--params JSON] [--out OUT.glb]`
 //! Defaults: ../shared/meshes/fandisk.obj and homer.obj. `--dense` applies two steps of √3
 //! subdivision without smoothing (×9 faces, ~54k/58k vertices for homer/fandisk): the issue's "two ~50k-vertex
-//! genus-0 meshes to a 30-frame GLB" case. Prints the report's headline numbers and the wall time.
+//! genus-0 meshes to a 30-frame GLB" case. `--centroid` splits every face at its centroid twice
+//! instead (same vertex counts, many thin triangles). Prints the report's headline numbers and the wall time.
 
 use std::time::Instant;
 
@@ -63,12 +64,14 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut paths = Vec::new();
     let mut dense = false;
+    let mut centroid = false;
     let mut params = serde_json::json!({});
     let mut out: Option<String> = None;
     let mut i = 0;
     while i < args.len() {
         match args[i].as_str() {
             "--dense" => dense = true,
+            "--centroid" => centroid = true,
             "--params" => {
                 i += 1;
                 params = serde_json::from_str(&args[i]).expect("--params takes JSON");
@@ -92,6 +95,9 @@ fn main() {
             .mesh;
         if dense {
             m = sqrt3_split(&sqrt3_split(&m));
+        }
+        if centroid {
+            m = centroid_split(&centroid_split(&m));
         }
         println!("{p}: {} vertices, {} faces", m.vertex_count(), m.face_count());
         meshes.push(m);

@@ -10,8 +10,9 @@ use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings};
 use meshwork_core::morph::trimesh::TriMesh;
-use meshwork_core::register::{self, surface::closest_on_triangle};
+use meshwork_core::register;
 use meshwork_core::shapes;
+use meshwork_core::spatial::closest_on_triangle;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
@@ -38,7 +39,7 @@ fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
                 .map(|t| {
                     norm(sub(
                         p,
-                        closest_on_triangle(p, pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]),
+                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
                     ))
                 })
                 .fold(f64::INFINITY, f64::min)
@@ -107,6 +108,71 @@ fn assert_bijective(name: &str) -> param::ParamReport {
     assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-6, "{name}: total spherical area {total}");
     assert_eq!(map.report.foldovers, 0);
     map.report
+}
+
+/// One step of √3 subdivision without smoothing (Kobbelt 2000): a vertex at every face centroid,
+/// then every original edge flipped. Positions are unchanged, so the surface is the same but the
+/// triangles are dense and, on curved parts, nearly flat fans: the case where a vertex split once
+/// found no valid position on the sphere.
+fn sqrt3(m: &Mesh) -> Mesh {
+    let (t, _, _) = TriMesh::from_mesh(m);
+    let mut pos = t.pos.clone();
+    let n_old = pos.len() as u32;
+    let mut tris = Vec::new();
+    for tr in &t.tris {
+        let c = tr.iter().fold([0.0; 3], |s, &v| {
+            let p = t.pos[v as usize];
+            [s[0] + p[0] / 3.0, s[1] + p[1] / 3.0, s[2] + p[2] / 3.0]
+        });
+        pos.push(c);
+        let ci = pos.len() as u32 - 1;
+        for k in 0..3 {
+            tris.push([tr[k], tr[(k + 1) % 3], ci]);
+        }
+    }
+    let by_edge: std::collections::HashMap<(u32, u32), usize> =
+        tris.iter().enumerate().map(|(i, t)| ((t[0], t[1]), i)).collect();
+    let mut done = vec![false; tris.len()];
+    for i in 0..tris.len() {
+        let [a, b, c1] = tris[i];
+        if done[i] || a >= n_old || b >= n_old {
+            continue;
+        }
+        let j = by_edge[&(b, a)];
+        let c2 = tris[j][2];
+        tris[i] = [a, c2, c1];
+        tris[j] = [c2, b, c1];
+        done[i] = true;
+        done[j] = true;
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// Every spherical triangle positive and their areas adding up to 4π: the map is a bijection.
+fn assert_covers_sphere_once(name: &str, sphere: &[Point3], tris: &[[u32; 3]]) {
+    let mut total = 0.0;
+    for tr in tris {
+        let a = spherical_area(sphere[tr[0] as usize], sphere[tr[1] as usize], sphere[tr[2] as usize]);
+        assert!(a > 0.0, "{name}: flipped spherical triangle {tr:?}");
+        total += a;
+    }
+    assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-6, "{name}: total spherical area {total}");
+}
+
+#[test]
+fn dense_sqrt3_subdivided_sphere_and_ellipsoid_morph_without_foldovers() {
+    // 2 × √3 of a level-4 icosphere: 23,042 vertices, mostly in flat 9-triangle fans.
+    let a = sqrt3(&sqrt3(&shapes::icosphere(4, 1.0)));
+    let b = sqrt3(&sqrt3(&ellipsoid(4, [2.0, 1.0, 0.5])));
+    for (name, m) in [("sphere", &a), ("ellipsoid", &b)] {
+        let (t, _, _) = TriMesh::from_mesh(m);
+        let s = ParamSettings { working_vertices: 1000, ..settings() };
+        let map = param::parameterise(&t, &s, &Progress::new()).expect("dense input parameterises");
+        eprintln!("{name}: {} vertices: {:?}", t.pos.len(), map.report);
+        assert_eq!(map.report.foldovers, 0);
+        assert!(map.report.retries.is_empty(), "{name}: {:?}", map.report.retries);
+        assert_covers_sphere_once(name, &map.sphere, &t.tris);
+    }
 }
 
 #[test]

@@ -11,8 +11,8 @@ use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::planar::{self, PlanarMethod};
 use meshwork_core::morph::trimesh::TriMesh;
-use meshwork_core::register::surface::closest_on_triangle;
 use meshwork_core::shapes;
+use meshwork_core::spatial::closest_on_triangle;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
@@ -31,7 +31,7 @@ fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
                 .map(|t| {
                     norm(sub(
                         p,
-                        closest_on_triangle(p, pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]),
+                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
                     ))
                 })
                 .fold(f64::INFINITY, f64::min)

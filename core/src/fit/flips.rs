@@ -90,8 +90,14 @@ pub fn with_matched_stars(tris: &[[u32; 3]], flagged: &[u32], matched: &[u32]) -
 
 /// Splits every edge of the `flagged` faces at its midpoint and re-triangulates each touched face
 /// conformingly (1→2, 1→3 or 1→4, red-green style), so no T-junctions appear. Returns how many
-/// faces were added.
-pub fn subdivide(pos: &mut Vec<Point3>, tris: &mut Vec<[u32; 3]>, flagged: &[u32]) -> usize {
+/// faces were added. New vertices are appended to `pos`; their edge ends are appended to `parents`
+/// in the same order (for attribute interpolation).
+pub fn subdivide(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    flagged: &[u32],
+    parents: &mut Vec<[(u32, f64); 3]>,
+) -> usize {
     let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
     for &f in flagged {
         let t = tris[f as usize];
@@ -101,6 +107,7 @@ pub fn subdivide(pos: &mut Vec<Point3>, tris: &mut Vec<[u32; 3]>, flagged: &[u32
             mid.entry(key).or_insert_with(|| {
                 let (pa, pb) = (pos[a as usize], pos[b as usize]);
                 pos.push(scale(crate::geometry::add(pa, pb), 0.5));
+                parents.push([(a, 0.5), (b, 0.5), (a, 0.0)]);
                 (pos.len() - 1) as u32
             });
         }
@@ -167,7 +174,9 @@ mod tests {
         // Two triangles sharing edge 1-2; flag the first: it splits 1→4, its neighbour 1→2.
         let mut pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
         let mut tris = vec![[0, 1, 2], [1, 3, 2]];
-        let added = subdivide(&mut pos, &mut tris, &[0]);
+        let mut parents = Vec::new();
+        let added = subdivide(&mut pos, &mut tris, &[0], &mut parents);
+        assert_eq!(parents.len(), 3);
         assert_eq!(added, 4);
         assert_eq!(pos.len(), 7);
         // Conforming: every interior edge is used exactly twice (once per direction).

@@ -18,6 +18,7 @@ pub mod align;
 pub mod correspond;
 pub mod curves;
 pub mod flips;
+pub mod insert;
 pub mod kdtree;
 pub mod partition;
 pub mod rbf;
@@ -62,6 +63,19 @@ pub enum Alignment {
     None,
 }
 
+/// How curve vertices get their template vertices before the fine RBF.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, utoipa::ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Matching {
+    /// Split the template at each curve vertex's closest surface point (local refinement; one
+    /// template vertex per curve vertex whatever the curve density). The RBF is solved once.
+    #[default]
+    Insert,
+    /// The seed's §2.1 rule: the nearest existing template vertex, feature points first; flips
+    /// are handled by subdividing and re-matching (one RBF solve per round).
+    NearestVertex,
+}
+
 /// What to do when the RBF centres are all on one plane (the system is then singular).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, utoipa::ToSchema)]
 #[serde(rename_all = "snake_case")]
@@ -82,6 +96,8 @@ pub struct FitParams {
     pub alignment: Alignment,
     /// Radial function of both RBF levels.
     pub kernel: Kernel,
+    /// How curve vertices are matched to template vertices for the fine RBF.
+    pub matching: Matching,
     pub coplanar_centres: CoplanarCentres,
     /// Curve endpoints closer than this × the curves' bounding-box diagonal are one vertex.
     pub join_tolerance: f64,
@@ -111,6 +127,7 @@ impl Default for FitParams {
             pairs: Vec::new(),
             alignment: Alignment::Auto,
             kernel: Kernel::Linear,
+            matching: Matching::Insert,
             coplanar_centres: CoplanarCentres::Reject,
             join_tolerance: 1e-6,
             max_curve_distance: 0.25,
@@ -171,20 +188,38 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             actual: net.points.len() as u64,
         });
     }
-    let mut tris = crate::shapes::fan_triangles(&template.faces);
-    if tris.is_empty() {
-        return Err(Error::params("template", "the template has no faces"));
-    }
-    // Fails early, naming the face, on a non-manifold or inconsistently oriented template.
-    drop(trimesh::TriMesh::new(template.positions.clone(), tris.clone())?);
+    let mut tris = stages.run(progress, "validate", || {
+        let tris = crate::shapes::fan_triangles(&template.faces);
+        if tris.is_empty() {
+            return Err(Error::params("template", "the template has no faces"));
+        }
+        // Fails early, naming the face, on a non-manifold or inconsistently oriented template.
+        trimesh::check_oriented_manifold(&tris)?;
+        Ok(tris)
+    })?;
     let template_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
 
     let coarse =
         stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
 
-    let fine = stages.run(progress, "fine", || {
-        fine_fit(&mut pos, &mut tris, &net, &coarse, params, template_diag, progress)
+    // Vertices added by the fine stage, as weighted combinations of older ones (vertex
+    // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
+    let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
+    let fine = stages.run(progress, "fine", || match params.matching {
+        Matching::Insert => fine_fit_inserted(
+            &mut pos,
+            &mut tris,
+            &net,
+            &coarse,
+            params,
+            template_diag,
+            &mut parents,
+            progress,
+        ),
+        Matching::NearestVertex => {
+            fine_fit(&mut pos, &mut tris, &net, &coarse, params, template_diag, &mut parents, progress)
+        }
     })?;
 
     let reference_normals = report::vertex_normals(&fine.positions, &tris);
@@ -224,18 +259,21 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         faces.push(t, g);
     }
     let mut out = Mesh::new(out_pos, faces);
+    out.uvs = template.uvs.as_ref().map(|uv| interpolate_uvs(uv, &parents));
     out.groups = (0..region_count).map(|i| format!("region_{i}")).collect();
     out.curves = report::polyline_chains(&net, &realised.chains);
 
-    let quality = report::Quality::measure(
-        &out,
-        &net,
-        &fine.vertex_of_point,
-        &realised,
-        &out_tris,
-        &fine.positions,
-        &reference_normals,
-    );
+    let quality = stages.run(progress, "quality", || {
+        Ok(report::Quality::measure(
+            &out,
+            &net,
+            &fine.vertex_of_point,
+            &realised,
+            &out_tris,
+            &fine.positions,
+            &reference_normals,
+        ))
+    })?;
     let report = serde_json::json!({
         "template_vertices": template.vertex_count(),
         "template_faces": template.face_count(),
@@ -510,6 +548,149 @@ pub struct FineReport {
     /// Faces still flipped by the last round (goal 0).
     pub flipped_faces: usize,
     pub augmented: bool,
+    /// "insert" or "nearest_vertex".
+    pub matching: &'static str,
+    /// What the insertion did (matching = insert).
+    pub insertion: Option<insert::InsertStats>,
+    /// Milliseconds per step of the fine stage (matching = insert): insert, solve, evaluate, flips.
+    pub steps_ms: Option<[f64; 4]>,
+}
+
+/// Fails, naming the curve, when a curve vertex is farther than the limit from its template vertex.
+fn check_distances(
+    distances: &[f64],
+    net: &curves::CurveNetwork,
+    params: &FitParams,
+    template_diag: f64,
+) -> Result<()> {
+    let limit = params.max_curve_distance * template_diag;
+    if let Some((p, d)) = distances.iter().enumerate().find(|(_, &d)| d > limit) {
+        let c = net.curve_of_point[p];
+        return Err(Error::params(
+            "curves",
+            format!(
+                "curve {c}: its point {:?} is {d:.4} from the template, more than \
+                 max_curve_distance ({}) × the template's bounding-box diagonal ({template_diag:.4}) \
+                 after alignment; the curves do not lie on the template (check units, or give pairs)",
+                net.points[p], params.max_curve_distance
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The fine stage with `Matching::Insert`: split the template at the curve vertices' feet, solve
+/// the RBF once, and handle flips by subdividing the flagged faces under the *same* field (the
+/// centres never change, so only the new midpoints are evaluated: no re-solve per round).
+#[allow(clippy::too_many_arguments)]
+fn fine_fit_inserted(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    progress: &Progress,
+) -> Result<Fine> {
+    let pair_fixed: Vec<(u32, u32)> =
+        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let clock = std::time::Instant::now();
+    let mut steps_ms = [0.0; 4];
+    let mut lap = |k: usize| {
+        steps_ms[k] = clock.elapsed().as_secs_f64() * 1e3 - steps_ms.iter().sum::<f64>();
+    };
+    let before = tris.clone();
+    let nv0 = pos.len();
+    let ins = insert::insert_curve_points(pos, tris, net, &pair_fixed, progress)?;
+    for c in &ins.created_in[nv0..] {
+        let (f, l) = c.ok_or_else(|| Error::Internal("inserted vertex without origin".into()))?;
+        let t = before[f as usize];
+        parents.push([(t[0], l[0]), (t[1], l[1]), (t[2], l[2])]);
+    }
+    drop(before);
+    let vop = ins.vertex_of_point.clone();
+    let distances: Vec<f64> = (0..vop.len()).map(|p| dist(net.points[p], pos[vop[p] as usize])).collect();
+    check_distances(&distances, net, params, template_diag)?;
+    let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
+    let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
+    let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
+    let before_aug = centres.len();
+    lap(0);
+    let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
+    lap(1);
+    let augmented = f.centre_count() > before_aug;
+    let disp = f.eval_many(pos, progress)?;
+    let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
+    for (p, &v) in vop.iter().enumerate() {
+        moved[v as usize] = net.points[p]; // exact, not RBF round-off
+    }
+    lap(2);
+    let mut scan = flips::detect(pos, &moved, tris);
+    let mut flagged_per_round = vec![scan.flipped.len()];
+    let (mut rounds, mut faces_added) = (1, 0);
+    let budget = tris.len() / 2;
+    while !scan.flipped.is_empty()
+        && rounds <= params.max_flip_iterations
+        && faces_added + 6 * scan.flipped.len() <= budget
+    {
+        progress.check()?;
+        let (p0, t0, par0) = (pos.len(), tris.clone(), parents.len());
+        let added = flips::subdivide(pos, tris, &scan.flipped, parents);
+        let d = f.eval_many(&pos[p0..], progress)?;
+        moved.extend(pos[p0..].iter().zip(d).map(|(p, d)| add(*p, d)));
+        let next = flips::detect(pos, &moved, tris);
+        flagged_per_round.push(next.flipped.len());
+        rounds += 1;
+        if next.flipped.len() >= scan.flipped.len() {
+            // No better under this field: undo the round (smaller faces fold the same way).
+            pos.truncate(p0);
+            moved.truncate(p0);
+            parents.truncate(par0);
+            *tris = t0;
+            break;
+        }
+        faces_added += added;
+        scan = next;
+    }
+    lap(3);
+    let n = distances.len().max(1) as f64;
+    Ok(Fine {
+        positions: moved,
+        vertex_of_point: vop,
+        report: FineReport {
+            rounds,
+            correspondence_conflicts: ins.stats.nudged,
+            correspondence_distance_max: distances.iter().cloned().fold(0.0, f64::max),
+            correspondence_distance_mean: distances.iter().sum::<f64>() / n,
+            flagged_per_round,
+            flagged_by_counter: scan.by_counter,
+            flagged_by_orientation: scan.by_orientation,
+            faces_added,
+            flipped_faces: scan.flipped.len(),
+            augmented,
+            matching: "insert",
+            insertion: Some(ins.stats),
+            steps_ms: Some(steps_ms),
+        },
+    })
+}
+
+/// The template's UVs extended to the vertices the fit added (each a weighted combination of
+/// older vertices, in creation order).
+pub fn interpolate_uvs(uv: &[[f64; 2]], parents: &[[(u32, f64); 3]]) -> Vec<[f64; 2]> {
+    let mut out = uv.to_vec();
+    out.reserve(parents.len());
+    for p in parents {
+        let mut u = [0.0; 2];
+        for &(v, w) in p {
+            let q = out[v as usize];
+            u[0] += w * q[0];
+            u[1] += w * q[1];
+        }
+        out.push(u);
+    }
+    out
 }
 
 fn fine_fit(
@@ -519,10 +700,12 @@ fn fine_fit(
     coarse: &CoarseReport,
     params: &FitParams,
     template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
 ) -> Result<Fine> {
     let pair_fixed: Vec<(u32, u32)> =
         coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let nv0 = pos.len() - parents.len();
     let mut flagged_per_round = Vec::new();
     let mut faces_added = 0;
     let budget = tris.len(); // subdivision may at most double the face count
@@ -530,19 +713,7 @@ fn fine_fit(
     for round in 0..=params.max_flip_iterations {
         progress.check()?;
         let corr = correspond::closest(pos, net, &pair_fixed, progress)?;
-        let limit = params.max_curve_distance * template_diag;
-        if let Some((p, d)) = corr.distances.iter().enumerate().find(|(_, &d)| d > limit) {
-            let c = net.curve_of_point[p];
-            return Err(Error::params(
-                "curves",
-                format!(
-                    "curve {c}: its point {:?} is {d:.4} from the nearest template vertex, more than \
-                     max_curve_distance ({}) × the template's bounding-box diagonal ({template_diag:.4}) \
-                     after alignment; the curves do not lie on the template (check units, or give pairs)",
-                    net.points[p], params.max_curve_distance
-                ),
-            ));
-        }
+        check_distances(&corr.distances, net, params, template_diag)?;
         let vop = corr.vertex_of_point.clone();
         let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
         let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
@@ -574,6 +745,9 @@ fn fine_fit(
                 faces_added,
                 flipped_faces: scan.flipped.len(),
                 augmented,
+                matching: "nearest_vertex",
+                insertion: None,
+                steps_ms: None,
             },
         };
         // Keep the round with the fewest flips; a round that does not improve stops the loop
@@ -595,9 +769,10 @@ fn fine_fit(
         // usually comes from a curve vertex matched to a template vertex a whole edge away, and
         // the star's new edge midpoints give it a closer candidate in the next round.
         let split = flips::with_matched_stars(tris, &flagged, &matched_now);
-        faces_added += flips::subdivide(pos, tris, &split);
+        faces_added += flips::subdivide(pos, tris, &split, parents);
     }
     if let Some((mut fine, p, t)) = best {
+        parents.truncate(p.len() - nv0);
         *pos = p;
         *tris = t;
         fine.report.flagged_per_round = flagged_per_round;

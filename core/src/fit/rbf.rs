@@ -162,7 +162,7 @@ impl Rbf {
             }
         }
         let a0 = a.clone();
-        let x = lu_solve(a, rhs.clone())?;
+        let x = symmetric_solve(a, rhs.clone())?;
         // Residual guard: an ill-conditioned system shows up here rather than as a silent misfit.
         let r = &a0 * &x - &rhs;
         let vmax = values.iter().flat_map(|v| v.iter()).fold(0.0f64, |m, c| m.max(c.abs())).max(1e-300);
@@ -205,16 +205,70 @@ impl Rbf {
             (p[1] - self.origin[1]) / self.scale,
             (p[2] - self.origin[2]) / self.scale,
         ];
-        let (sx, sy, sz) = match self.kernel {
-            Kernel::Linear => self.radial_sum(q, |r| r),
-            Kernel::Cubic => self.radial_sum(q, |r| r * r * r),
-        };
+        let (sx, sy, sz) = self.radial(q);
         let a = &self.affine;
         [
             sx + a[0][0] * q[0] + a[1][0] * q[1] + a[2][0] * q[2] + a[3][0],
             sy + a[0][1] * q[0] + a[1][1] * q[1] + a[2][1] * q[2] + a[3][1],
             sz + a[0][2] * q[0] + a[1][2] * q[1] + a[2][2] * q[2] + a[3][2],
         ]
+    }
+
+    /// Σ_j φ(|q − c_j|) α_j, with AVX2 + FMA when the CPU has them (4 square roots per instruction
+    /// instead of 2: this loop is the 100k × 2k kernel evaluations of the fine stage).
+    #[inline]
+    fn radial(&self, q: Point3) -> (f64, f64, f64) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the features were just detected on this CPU.
+            return unsafe { self.radial_avx2(q) };
+        }
+        match self.kernel {
+            Kernel::Linear => self.radial_sum(q, |r| r),
+            Kernel::Cubic => self.radial_sum(q, |r| r * r * r),
+        }
+    }
+
+    /// The same sum with explicit 4-lane AVX2 (the auto-vectoriser only used 2 lanes here).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn radial_avx2(&self, q: Point3) -> (f64, f64, f64) {
+        use std::arch::x86_64::*;
+        let n = self.cx.len();
+        let (cx, cy, cz) = (&self.cx[..n], &self.cy[..n], &self.cz[..n]);
+        let (wx, wy, wz) = (&self.w[0][..n], &self.w[1][..n], &self.w[2][..n]);
+        let cubic = self.kernel == Kernel::Cubic;
+        let (qx, qy, qz) = (_mm256_set1_pd(q[0]), _mm256_set1_pd(q[1]), _mm256_set1_pd(q[2]));
+        let (mut ax, mut ay, mut az) = (_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd());
+        let chunks = n / 4;
+        for c in 0..chunks {
+            let j = c * 4;
+            // SAFETY: j + 4 ≤ n for every slice (all have length n).
+            let dx = _mm256_sub_pd(qx, _mm256_loadu_pd(cx.as_ptr().add(j)));
+            let dy = _mm256_sub_pd(qy, _mm256_loadu_pd(cy.as_ptr().add(j)));
+            let dz = _mm256_sub_pd(qz, _mm256_loadu_pd(cz.as_ptr().add(j)));
+            let r2 = _mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx)));
+            let r = _mm256_sqrt_pd(r2);
+            let f = if cubic { _mm256_mul_pd(r, r2) } else { r };
+            ax = _mm256_fmadd_pd(f, _mm256_loadu_pd(wx.as_ptr().add(j)), ax);
+            ay = _mm256_fmadd_pd(f, _mm256_loadu_pd(wy.as_ptr().add(j)), ay);
+            az = _mm256_fmadd_pd(f, _mm256_loadu_pd(wz.as_ptr().add(j)), az);
+        }
+        let hsum = |v: __m256d| {
+            let mut a = [0.0f64; 4];
+            _mm256_storeu_pd(a.as_mut_ptr(), v);
+            (a[0] + a[1]) + (a[2] + a[3])
+        };
+        let (mut sx, mut sy, mut sz) = (hsum(ax), hsum(ay), hsum(az));
+        for j in chunks * 4..n {
+            let (dx, dy, dz) = (q[0] - cx[j], q[1] - cy[j], q[2] - cz[j]);
+            let r2 = dx * dx + dy * dy + dz * dz;
+            let f = if cubic { r2 * r2.sqrt() } else { r2.sqrt() };
+            sx += f * wx[j];
+            sy += f * wy[j];
+            sz += f * wz[j];
+        }
+        (sx, sy, sz)
     }
 
     /// Σ_j φ(|q − c_j|) α_j. Equal-length slices and a kernel fixed per call let the compiler
@@ -263,7 +317,40 @@ impl Rbf {
     }
 }
 
+/// Dense symmetric-indefinite solve: Bunch–Kaufman LBLᵀ (half the flops of LU, pivoted, so the
+/// zero diagonal and zero affine block are fine), sequential (faer's parallel mode is never used).
+fn symmetric_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
+    use faer::linalg::cholesky::lblt::{factor as bk, solve as bks};
+    let n = a.nrows();
+    let mut subdiag = faer::diag::Diag::<f64>::zeros(n);
+    let mut perm = vec![0usize; n];
+    let mut perm_inv = vec![0usize; n];
+    let par = Par::Seq;
+    let mut buf = MemBuffer::new(bk::cholesky_in_place_scratch::<usize, f64>(n, par, Default::default()));
+    let (_, p) = bk::cholesky_in_place(
+        a.as_mut(),
+        subdiag.as_mut(),
+        &mut perm,
+        &mut perm_inv,
+        par,
+        MemStack::new(&mut buf),
+        Default::default(),
+    );
+    let mut buf2 = MemBuffer::new(bks::solve_in_place_scratch::<usize, f64>(n, rhs.ncols(), par));
+    bks::solve_in_place(
+        a.as_ref(),
+        a.diagonal(),
+        subdiag.as_ref(),
+        p,
+        rhs.as_mut(),
+        par,
+        MemStack::new(&mut buf2),
+    );
+    Ok(rhs)
+}
+
 /// Dense LU with partial pivoting, sequential (faer's parallel mode is never used: see DESIGN).
+#[allow(dead_code)]
 fn lu_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
     let n = a.nrows();
     let mut perm = vec![0usize; n];
@@ -334,6 +421,29 @@ mod tests {
             let (e, t) = (f.eval(p), d(p));
             for k in 0..3 {
                 assert!((e[k] - t[k]).abs() < 1e-9 * (1.0 + t[k].abs()), "{e:?} vs {t:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn simd_and_scalar_sums_agree() {
+        // 23 centres (not a multiple of 4: the tail runs too), pseudo-random values.
+        let c: Vec<Point3> = (0..23)
+            .map(|i| [(i as f64 * 0.37).sin(), (i as f64 * 0.91).cos(), (i * i % 7) as f64 * 0.1])
+            .collect();
+        let vals: Vec<Point3> =
+            (0..23).map(|i| [(i as f64).sin(), 0.1 * i as f64, -0.05 * (i % 5) as f64]).collect();
+        for kernel in [Kernel::Linear, Kernel::Cubic] {
+            let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
+            for q in [[0.1, 0.2, 0.3], [-2.0, 1.0, 0.5]] {
+                let a = match kernel {
+                    Kernel::Linear => f.radial_sum(q, |r| r),
+                    Kernel::Cubic => f.radial_sum(q, |r| r * r * r),
+                };
+                let b = f.radial(q);
+                for (x, y) in [(a.0, b.0), (a.1, b.1), (a.2, b.2)] {
+                    assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{kernel:?}: {x} vs {y}");
+                }
             }
         }
     }

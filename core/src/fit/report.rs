@@ -2,11 +2,10 @@
 
 use serde::Serialize;
 
-use crate::geometry::{add, corner_angle, dist, dot, norm2, normalize, scale, sub, triangle_cross};
+use crate::geometry::{add, corner_angle, dist, dot, norm2, normalize, sub, triangle_cross};
 use crate::mesh::{Mesh, Point3};
 
 use super::curves::CurveNetwork;
-use super::kdtree::KdTree;
 use super::retriangulate::Realised;
 use super::trimesh::IntMap;
 
@@ -87,7 +86,7 @@ pub struct Quality {
 
 impl Quality {
     /// `reference_pos`/`reference_normals`: the fine-deformed mesh before re-triangulation; an
-    /// output face counts as flipped when its normal opposes the reference normal nearest to it.
+    /// output face counts as flipped when its normal opposes the sum of its corners' reference normals.
     pub fn measure(
         out: &Mesh,
         net: &CurveNetwork,
@@ -121,16 +120,15 @@ impl Quality {
                 c.len() >= 2 && c.windows(2).all(|w| edges.contains_key(&(w[0].min(w[1]), w[0].max(w[1]))))
             })
             .count();
-        let tree = KdTree::new(reference_pos);
+        // Retriangulation adds no vertices, so each output face has reference normals at its own
+        // corners (no nearest-point search).
+        let _ = reference_pos;
         let flipped = tris
             .iter()
             .filter(|t| {
                 let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-                let centroid = scale(add(add(a, b), c), 1.0 / 3.0);
-                match tree.nearest(centroid) {
-                    Some((v, _)) => dot(triangle_cross(a, b, c), reference_normals[v as usize]) < 0.0,
-                    None => false,
-                }
+                let r = t.iter().fold([0.0; 3], |acc, &v| add(acc, reference_normals[v as usize]));
+                dot(triangle_cross(a, b, c), r) < 0.0
             })
             .count();
         Quality {

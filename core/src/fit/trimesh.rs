@@ -32,6 +32,32 @@ impl Hasher for IntHasher {
 
 pub type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
 
+/// The check [`TriMesh::new`] makes, without building the mesh: no face repeats a vertex and no
+/// directed edge is used twice (a sort, not a hash map: this runs on every template).
+pub fn check_oriented_manifold(tris: &[[u32; 3]]) -> Result<()> {
+    let mut keys: Vec<(u64, u32)> = Vec::with_capacity(tris.len() * 3);
+    for (fi, t) in tris.iter().enumerate() {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            return Err(Error::Topology(format!("template face {fi} repeats a vertex {t:?}")));
+        }
+        for k in 0..3 {
+            keys.push((((t[k] as u64) << 32) | t[(k + 1) % 3] as u64, fi as u32));
+        }
+    }
+    keys.sort_unstable();
+    for w in keys.windows(2) {
+        if w[0].0 == w[1].0 {
+            let (a, b) = ((w[0].0 >> 32) as u32, w[0].0 as u32);
+            return Err(Error::Topology(format!(
+                "template edge ({a}, {b}) is used in the same direction by faces {} and {}: \
+                 the template is not an oriented manifold (run the repair job first)",
+                w[0].1, w[1].1
+            )));
+        }
+    }
+    Ok(())
+}
+
 pub struct TriMesh {
     pub pos: Vec<Point3>,
     pub tris: Vec<[u32; 3]>,
@@ -115,6 +141,11 @@ impl TriMesh {
 
     pub fn has_edge(&self, a: u32, b: u32) -> bool {
         self.half.contains_key(&(a, b)) || self.half.contains_key(&(b, a))
+    }
+
+    /// The face that has the directed edge a → b.
+    pub fn face_with_edge(&self, a: u32, b: u32) -> Option<u32> {
+        self.half.get(&(a, b)).copied()
     }
 
     /// The face on the other side of edge (a, b) from face `f`.

@@ -116,6 +116,36 @@ fn chord_param(a0: Point3, a1: Point3, p: Point3) -> f64 {
     }
 }
 
+/// A number in [0, 4) increasing with the angle of (x, y) like atan2 does, without trigonometry
+/// (the "diamond angle"): enough to order a polygon's corners around its centre.
+#[inline]
+fn pseudo_angle(x: f64, y: f64) -> f64 {
+    let s = x.abs() + y.abs();
+    if s == 0.0 {
+        return 0.0;
+    }
+    let r = y / s;
+    if x >= 0.0 {
+        if y >= 0.0 {
+            r
+        } else {
+            4.0 + r
+        }
+    } else {
+        2.0 - r
+    }
+}
+
+/// f64 with a total order, as a sort key.
+#[derive(PartialEq, PartialOrd)]
+struct Angle(f64);
+impl Eq for Angle {}
+impl Ord for Angle {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
 fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
     add(a, scale(sub(b, a), t))
 }
@@ -216,11 +246,7 @@ pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, Over
                 cross(c, [0.0, 1.0, 0.0])
             });
             let e2 = cross(c, e1);
-            corners.sort_by(|x, y| {
-                let ax = dot(x.1, e2).atan2(dot(x.1, e1));
-                let ay = dot(y.1, e2).atan2(dot(y.1, e1));
-                ax.total_cmp(&ay)
-            });
+            corners.sort_by_cached_key(|x| Angle(pseudo_angle(dot(x.1, e1), dot(x.1, e2))));
             let mut poly: Vec<u32> = Vec::with_capacity(corners.len());
             for &(label, p, fa_, fb_) in corners.iter() {
                 let id = match ids.get(&label) {
@@ -350,4 +376,32 @@ pub fn transfer(a: &Layer, b: &Layer, progress: &Progress) -> Result<Layer> {
     }
     shapes.extend(extra);
     Ok(Layer { sphere: a.sphere.clone(), tris: a.tris.clone(), shapes })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pseudo_angle_orders_directions_like_atan2() {
+        // 720 directions around the circle, from just past −π: the pseudo-angle must sort them
+        // in the same cyclic order as the angle itself (one wrap, at the positive x axis).
+        let angles: Vec<f64> =
+            (1..=720).map(|k| -std::f64::consts::PI + k as f64 * std::f64::consts::PI / 360.0).collect();
+        let key = |a: f64| {
+            let p = pseudo_angle(a.cos(), a.sin());
+            assert!((0.0..4.0).contains(&p), "{a}: {p}");
+            p
+        };
+        for w in angles.windows(2) {
+            let (ka, kb) = (key(w[0]), key(w[1]));
+            // Increasing, except across angle 0 where the pseudo-angle wraps from ~4 to 0.
+            let crosses_zero = w[0] < 0.0 && w[1] >= 0.0;
+            assert!(kb > ka || crosses_zero, "{} → {}: {ka} → {kb}", w[0], w[1]);
+        }
+        assert_eq!(pseudo_angle(1.0, 0.0), 0.0);
+        assert_eq!(pseudo_angle(0.0, 1.0), 1.0);
+        assert_eq!(pseudo_angle(-1.0, 0.0), 2.0);
+        assert_eq!(pseudo_angle(0.0, -1.0), 3.0);
+    }
 }

@@ -352,7 +352,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             .collect();
         let mut icp = Vec::new();
         if params.registration == Registration::PcaIcp {
-            let target = register::surface::SurfaceIndex::new(&norm[0].pos, &norm[0].tris);
+            let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
             for k in 1..k_in {
                 progress.fraction(k as f64 / k_in as f64)?;
                 let r = register::icp(&norm[k].pos, &target, 50);

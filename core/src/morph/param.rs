@@ -75,6 +75,9 @@ pub struct ParamReport {
     /// Why the fallback was used, if it was.
     pub fallback_reason: Option<String>,
     pub vertex_splits: usize,
+    /// Vertex splits that found no valid position at first and succeeded after smoothing the
+    /// neighbourhood of the split vertex.
+    pub local_repairs: usize,
     /// Faces of the final map with det ≤ 0 (must be 0).
     pub foldovers: usize,
     /// AD, seed 002 eq. IV.64 (radians): mean |angle in 3D − angle of the spherical chord triangle|.
@@ -161,7 +164,25 @@ fn parameterise_once(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> 
     let mut done = 0usize;
     relax(&h, &mesh.pos, &mut sphere, s.relax_sweeps, progress)?;
     while let Some(rec) = h.split_last() {
-        place_split(&h, rec.vt, rec.vs, &mesh.pos, &mut sphere)?;
+        if let Err(e) = place_split(&h, rec.vt, rec.vs, &mesh.pos, &mut sphere) {
+            // No valid position (the kernel of vt's star is empty or too thin to hit): undo the
+            // split, widen the triangles around vs by kernel-centred moves over a growing
+            // neighbourhood, and split again.
+            let mut placed = false;
+            for radius in 1..=4 {
+                h.redo(&rec);
+                smooth_around(&h, rec.vs, radius, 2 + radius, &mesh.pos, &mut sphere);
+                h.split_last();
+                if place_split(&h, rec.vt, rec.vs, &mesh.pos, &mut sphere).is_ok() {
+                    placed = true;
+                    break;
+                }
+            }
+            if !placed {
+                return Err(e);
+            }
+            rep.local_repairs += 1;
+        }
         done += 1;
         if done % 2048 == 0 {
             progress.fraction(done as f64 / total.max(1) as f64)?;
@@ -269,7 +290,10 @@ fn flatten_to_star(
         for v in 0..n {
             heap.push((Key(ks(&p, v).abs()), v as u32, 0));
         }
-        let mut parked = Vec::new();
+        // A vertex whose move would be too small is dropped from the heap: its curvature and
+        // target depend only on its neighbours, and when one of them moves it is queued again
+        // with a new stamp. (Re-queuing every parked vertex after each move made a round
+        // quadratic in the working size.)
         for _ in 0..5 * n {
             let mut moved = false;
             while let Some((_, v, st)) = heap.pop() {
@@ -282,7 +306,6 @@ fn flatten_to_star(
                     1.0 / nbrs[v].len() as f64,
                 );
                 if norm(sub(bary, p[v])) <= min_move {
-                    parked.push(v);
                     continue;
                 }
                 p[v] = bary;
@@ -292,9 +315,6 @@ fn flatten_to_star(
                 }
                 moved = true;
                 break;
-            }
-            for v in parked.drain(..) {
-                heap.push((Key(ks(&p, v).abs()), v as u32, stamp[v]));
             }
             if !moved {
                 break;
@@ -383,6 +403,128 @@ fn star_quality(x: Point3, ring: &[(Point3, Point3, Point3)]) -> Option<f64> {
     Some(q)
 }
 
+/// The stars of a vertex as (a, b, a×b) per face (v, a, b): the orientation test of a candidate
+/// position x for every face is `dot(x, a×b) > 0`.
+fn star(h: &Hierarchy, v: u32, sphere: &[Point3]) -> Vec<(Point3, Point3, Point3)> {
+    ring_pairs(h, v)
+        .iter()
+        .map(|&(a, b)| {
+            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+            (pa, pb, cross(pa, pb))
+        })
+        .collect()
+}
+
+/// Candidate positions inside the kernel of a star on the sphere (the region where every face
+/// (x, a, b) is positively oriented), appended to `out`. The kernel is computed exactly as a
+/// convex polygon: in the gnomonic (central) projection onto the plane tangent at the ring's
+/// centre, great circles are straight lines, so each face contributes one half-plane and the
+/// kernel is their intersection (clipping a large square, Sutherland–Hodgman). Candidates are
+/// the polygon's area centroid and points from it towards `prefer` (the mean-value target).
+/// Returns false when the ring does not fit in one hemisphere or the kernel is empty.
+fn kernel_candidates(ring: &[(Point3, Point3, Point3)], prefer: Point3, out: &mut Vec<Point3>) -> bool {
+    let c = normalize(ring.iter().fold([0.0; 3], |s, r| add(s, r.0)));
+    if !ring.iter().all(|r| dot(r.0, c) > 0.05 && dot(r.1, c) > 0.05) {
+        return false;
+    }
+    let e1 = normalize(if c[0].abs() < 0.9 { cross(c, [1.0, 0.0, 0.0]) } else { cross(c, [0.0, 1.0, 0.0]) });
+    let e2 = cross(c, e1);
+    const L: f64 = 25.0;
+    let mut poly: Vec<[f64; 2]> = vec![[-L, -L], [L, -L], [L, L], [-L, L]];
+    let mut next: Vec<[f64; 2]> = Vec::with_capacity(16);
+    for r in ring {
+        let len = norm(r.2);
+        if !(len > 0.0) {
+            return false;
+        }
+        let h = [dot(r.2, c) / len, dot(r.2, e1) / len, dot(r.2, e2) / len];
+        let f = |p: [f64; 2]| h[0] + h[1] * p[0] + h[2] * p[1];
+        next.clear();
+        for i in 0..poly.len() {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            let (fp, fq) = (f(p), f(q));
+            if fp >= 0.0 {
+                next.push(p);
+            }
+            if (fp >= 0.0) != (fq >= 0.0) {
+                let t = fp / (fp - fq);
+                next.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+            }
+        }
+        std::mem::swap(&mut poly, &mut next);
+        if poly.len() < 3 {
+            return false;
+        }
+    }
+    // Area centroid (shoelace).
+    let (mut a2, mut gx, mut gy) = (0.0, 0.0, 0.0);
+    for i in 0..poly.len() {
+        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+        let w = p[0] * q[1] - q[0] * p[1];
+        a2 += w;
+        gx += (p[0] + q[0]) * w;
+        gy += (p[1] + q[1]) * w;
+    }
+    if !(a2 > 0.0) {
+        return false;
+    }
+    let g = [gx / (3.0 * a2), gy / (3.0 * a2)];
+    let lift = |p: [f64; 2]| normalize(add(c, add(scale(e1, p[0]), scale(e2, p[1]))));
+    out.push(lift(g));
+    let dc = dot(prefer, c);
+    if dc > 0.05 {
+        let pp = [dot(prefer, e1) / dc, dot(prefer, e2) / dc];
+        for t in [0.25, 0.5, 0.75] {
+            out.push(lift([g[0] + t * (pp[0] - g[0]), g[1] + t * (pp[1] - g[1])]));
+        }
+    }
+    true
+}
+
+/// Moves `v` to the best of its mean-value target and its kernel candidates (best = highest
+/// worst-face shape quality) when that beats its current position.
+fn improve_vertex_kernel(h: &Hierarchy, v: u32, pos: &[Point3], sphere: &mut [Point3]) {
+    let ring = star(h, v, sphere);
+    let cur = star_quality(sphere[v as usize], &ring).unwrap_or(-1.0);
+    let target = mvc_target(h, v, pos, sphere);
+    let mut cands = vec![target];
+    kernel_candidates(&ring, target, &mut cands);
+    let mut best = (cur, sphere[v as usize]);
+    for x in cands {
+        if let Some(q) = star_quality(x, &ring) {
+            if q > best.0 {
+                best = (q, x);
+            }
+        }
+    }
+    sphere[v as usize] = best.1;
+}
+
+/// Gauss–Seidel sweeps of [`improve_vertex_kernel`] over the `radius`-ring of `v`: widens the thin
+/// spherical triangles around a vertex before a split there is retried.
+fn smooth_around(h: &Hierarchy, v: u32, radius: usize, sweeps: usize, pos: &[Point3], sphere: &mut [Point3]) {
+    let mut set = vec![v];
+    let mut frontier = vec![v];
+    for _ in 0..radius {
+        let mut nf = Vec::new();
+        for &u in &frontier {
+            for w in h.neighbours(u).iter().copied() {
+                if !set.contains(&w) {
+                    set.push(w);
+                    nf.push(w);
+                }
+            }
+        }
+        frontier = nf;
+    }
+    for _ in 0..sweeps {
+        // Outside in: the outer vertices make room first.
+        for &u in set.iter().rev() {
+            improve_vertex_kernel(h, u, pos, sphere);
+        }
+    }
+}
+
 /// Places the vertex `vt` just re-inserted by the split of `vs`.
 fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Point3]) -> Result<()> {
     let pairs = ring_pairs(h, vt);
@@ -401,22 +543,31 @@ fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Po
             }
         }
     };
-    // The mean-value target first (it usually wins and lowers distortion), then the lattice over
-    // the fan around vs that covered vt's region before the split, then points ever closer to vs
-    // (the valid region always contains such points, see the module docs).
-    consider(&mut best, mvc_target(h, vt, pos, sphere));
+    // The mean-value target first (it usually wins and lowers distortion), then points of the
+    // exact kernel of vt's star; only when the kernel cannot be computed (a ring wider than a
+    // hemisphere, near the tetrahedron) the lattice over the fan around vs that covered vt's
+    // region before the split, then points ever closer to vs.
+    let target = mvc_target(h, vt, pos, sphere);
+    consider(&mut best, target);
+    let mut cands = Vec::with_capacity(4);
     let ps = sphere[vs as usize];
-    for &(a, b) in &pairs {
-        if a == vs || b == vs {
-            continue;
+    if kernel_candidates(&ring, target, &mut cands) {
+        for x in cands {
+            consider(&mut best, x);
         }
-        let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
-        const L: usize = 4;
-        for i in 1..=L {
-            for j in 0..=(L - i) {
-                let k = L - i - j;
-                let x = add(add(scale(ps, i as f64), scale(pa, j as f64)), scale(pb, k as f64));
-                consider(&mut best, normalize(x));
+    } else {
+        for &(a, b) in &pairs {
+            if a == vs || b == vs {
+                continue;
+            }
+            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+            const L: usize = 4;
+            for i in 1..=L {
+                for j in 0..=(L - i) {
+                    let k = L - i - j;
+                    let x = add(add(scale(ps, i as f64), scale(pa, j as f64)), scale(pb, k as f64));
+                    consider(&mut best, normalize(x));
+                }
             }
         }
     }
@@ -466,7 +617,7 @@ fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Po
             sphere[vt as usize] = x;
             // The split shrank vs's star: let vs move to its ring's centroid if that improves its
             // worst triangle (keeps 180° corners from building up).
-            improve_vertex(h, vs, sphere);
+            improve_vertex_kernel(h, vs, pos, sphere);
             Ok(())
         }
         None => {
@@ -475,24 +626,15 @@ fn place_split(h: &Hierarchy, vt: u32, vs: u32, pos: &[Point3], sphere: &mut [Po
     }
 }
 
-/// Moves `v` to the normalised centroid of its ring when that is valid and raises the worst
-/// shape quality of its faces.
-fn improve_vertex(h: &Hierarchy, v: u32, sphere: &mut [Point3]) {
-    let pairs = ring_pairs(h, v);
-    let ring: Vec<(Point3, Point3, Point3)> = pairs
-        .iter()
-        .map(|&(a, b)| {
-            let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
-            (pa, pb, cross(pa, pb))
-        })
-        .collect();
-    let cur = star_quality(sphere[v as usize], &ring).unwrap_or(-1.0);
-    let c = normalize(ring.iter().fold([0.0; 3], |s, r| add(s, r.0)));
-    if let Some(q) = star_quality(c, &ring) {
-        if q > cur {
-            sphere[v as usize] = c;
-        }
-    }
+/// tan(θ/2) of the corner at `p` of the 3D triangle (p, a, b), divided by |a − p| and |b − p|:
+/// the two mean-value weight contributions of that face (Floater). tan(θ/2) = |u×v| / (|u||v| + u·v)
+/// needs no trigonometry (this is the inner loop of every relaxation sweep).
+#[inline]
+fn mvc_face_weights(p: Point3, a: Point3, b: Point3) -> (f64, f64) {
+    let (u, v) = (sub(a, p), sub(b, p));
+    let (la, lb) = (norm(u).max(1e-300), norm(v).max(1e-300));
+    let th = norm(cross(u, v)) / (la * lb + dot(u, v)).max(1e-300);
+    (th / la, th / lb)
 }
 
 /// normalize(Σ wᵢⱼ s_j) with Floater's mean-value weights from the 3D mesh.
@@ -503,14 +645,42 @@ fn mvc_target(h: &Hierarchy, v: u32, pos: &[Point3], sphere: &[Point3]) -> Point
         let t = h.tris[f as usize];
         let k = t.iter().position(|&x| x == v).unwrap_or(0);
         let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-        let theta = corner_angle(pv, pos[a as usize], pos[b as usize]);
-        let th = (theta / 2.0).tan();
-        let la = norm(sub(pos[a as usize], pv)).max(1e-300);
-        let lb = norm(sub(pos[b as usize], pv)).max(1e-300);
-        acc = add(acc, scale(sphere[a as usize], th / la));
-        acc = add(acc, scale(sphere[b as usize], th / lb));
+        let (wa, wb) = mvc_face_weights(pv, pos[a as usize], pos[b as usize]);
+        acc = add(acc, scale(sphere[a as usize], wa));
+        acc = add(acc, scale(sphere[b as usize], wb));
     }
     normalize(acc)
+}
+
+/// The alive vertices' stars in flat arrays (one relaxation call reuses them every sweep): for
+/// vertex slot i, `ring[start[i]..start[i+1]]` are its faces as (a, b) with (v, a, b)
+/// counter-clockwise and the mean-value weights of a and b.
+struct Stars {
+    verts: Vec<u32>,
+    start: Vec<u32>,
+    ring: Vec<(u32, u32, f64, f64)>,
+}
+
+impl Stars {
+    fn new(h: &Hierarchy, pos: &[Point3]) -> Stars {
+        let mut st = Stars { verts: Vec::new(), start: vec![0], ring: Vec::new() };
+        for v in 0..h.vertex_alive.len() {
+            if !h.vertex_alive[v] {
+                continue;
+            }
+            let pv = pos[v];
+            for &f in &h.vf[v] {
+                let t = h.tris[f as usize];
+                let k = t.iter().position(|&x| x as usize == v).unwrap_or(0);
+                let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+                let (wa, wb) = mvc_face_weights(pv, pos[a as usize], pos[b as usize]);
+                st.ring.push((a, b, wa, wb));
+            }
+            st.verts.push(v as u32);
+            st.start.push(st.ring.len() as u32);
+        }
+        st
+    }
 }
 
 /// Gauss–Seidel sweeps moving each alive vertex towards its mean-value target, only by moves
@@ -522,21 +692,23 @@ fn relax(
     sweeps: usize,
     progress: &Progress,
 ) -> Result<()> {
+    if sweeps == 0 {
+        return Ok(());
+    }
+    let stars = Stars::new(h, pos);
+    let mut ring: Vec<(Point3, Point3, Point3)> = Vec::with_capacity(32);
     for _ in 0..sweeps {
         progress.check()?;
-        for v in 0..h.vertex_alive.len() {
-            if !h.vertex_alive[v] {
-                continue;
+        for (i, &v) in stars.verts.iter().enumerate() {
+            let star = &stars.ring[stars.start[i] as usize..stars.start[i + 1] as usize];
+            let mut acc = [0.0; 3];
+            ring.clear();
+            for &(a, b, wa, wb) in star {
+                let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
+                acc = add(acc, add(scale(pa, wa), scale(pb, wb)));
+                ring.push((pa, pb, cross(pa, pb)));
             }
-            let v = v as u32;
-            let target = mvc_target(h, v, pos, sphere);
-            let ring: Vec<(Point3, Point3, Point3)> = ring_pairs(h, v)
-                .iter()
-                .map(|&(a, b)| {
-                    let (pa, pb) = (sphere[a as usize], sphere[b as usize]);
-                    (pa, pb, cross(pa, pb))
-                })
-                .collect();
+            let target = normalize(acc);
             let cur = sphere[v as usize];
             let mut x = target;
             for _ in 0..5 {

@@ -3,11 +3,12 @@
 //! diagonal).
 
 use crate::geometry::Aabb;
+use crate::mesh::Faces;
 use crate::mesh::Point3;
-use crate::register::surface::SurfaceIndex;
+use crate::spatial::Bvh;
 
 /// One-sided max distance from points (vertices and face centroids of A) to surface B.
-fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &SurfaceIndex, centroids: bool) -> f64 {
+fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &Bvh, centroids: bool) -> f64 {
     use rayon::prelude::*;
     let v = pa.par_iter().filter_map(|&p| b.closest(p)).map(|h| h.dist2).reduce(|| 0.0, f64::max);
     if !centroids {
@@ -36,8 +37,8 @@ pub fn relative_hausdorff(
     tb: &[[u32; 3]],
     a_centroids: bool,
 ) -> f64 {
-    let ia = SurfaceIndex::new(pa, ta);
-    let ib = SurfaceIndex::new(pb, tb);
+    let (ia, ib) =
+        rayon::join(|| Bvh::new(pa, &Faces::from_triangles(ta)), || Bvh::new(pb, &Faces::from_triangles(tb)));
     let d = one_sided(pa, ta, &ib, a_centroids).max(one_sided(pb, tb, &ia, true));
     let diag = Aabb::of(pb).map(|b| b.diagonal()).unwrap_or(1.0).max(1e-300);
     d / diag

@@ -15,6 +15,24 @@ use crate::geometry::{cross, dot, norm, normalize, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
+/// The neighbours of one vertex, on the stack up to valence 32.
+pub struct Ring {
+    n: usize,
+    small: [u32; 32],
+    big: Vec<u32>,
+}
+
+impl std::ops::Deref for Ring {
+    type Target = [u32];
+    fn deref(&self) -> &[u32] {
+        if self.n <= 32 {
+            &self.small[..self.n]
+        } else {
+            &self.big
+        }
+    }
+}
+
 /// One collapse `vt → vs`, enough to undo it exactly.
 #[derive(Clone, Debug)]
 pub struct Collapse {
@@ -126,13 +144,31 @@ impl Hierarchy {
         }
     }
 
-    /// Neighbours of an alive vertex (unordered, unique).
-    pub fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> =
-            self.vf[v as usize].iter().flat_map(|&f| self.tris[f as usize]).filter(|&w| w != v).collect();
-        n.sort_unstable();
-        n.dedup();
-        n
+    /// Neighbours of an alive vertex (unique, in no particular order): the vertex after `v` in
+    /// each of its faces, which lists every neighbour exactly once on a closed manifold (an
+    /// invariant here: every collapse passes the link condition). No allocation for valences
+    /// ≤ 32: this is called for every candidate collapse.
+    pub fn neighbours(&self, v: u32) -> Ring {
+        let faces = &self.vf[v as usize];
+        let next = |&f: &u32| {
+            let t = self.tris[f as usize];
+            if t[0] == v {
+                t[1]
+            } else if t[1] == v {
+                t[2]
+            } else {
+                t[0]
+            }
+        };
+        let mut r = Ring { n: faces.len(), small: [0; 32], big: Vec::new() };
+        if faces.len() <= 32 {
+            for (k, f) in faces.iter().enumerate() {
+                r.small[k] = next(f);
+            }
+        } else {
+            r.big = faces.iter().map(next).collect();
+        }
+        r
     }
 
     fn cost(&self, vt: u32, vs: u32) -> f64 {
@@ -153,11 +189,11 @@ impl Hierarchy {
             return false;
         }
         let nt = self.neighbours(vt);
-        if nt.binary_search(&vs).is_err() {
+        if !nt.contains(&vs) {
             return false;
         }
         let ns = self.neighbours(vs);
-        let common = nt.iter().filter(|v| ns.binary_search(v).is_ok()).count();
+        let common = nt.iter().filter(|v| ns.contains(v)).count();
         if common != 2 {
             return false;
         }
@@ -227,6 +263,13 @@ impl Hierarchy {
         self.records.push(Collapse { vt, vs, removed, changed: (start, end) });
     }
 
+    /// Collapses `rec` again right after [`Hierarchy::split_last`] returned it (the mesh is then
+    /// exactly as before the split): lets the parameterisation improve the neighbourhood of
+    /// `vs` and retry a split that found no valid position.
+    pub fn redo(&mut self, rec: &Collapse) {
+        self.collapse(rec.vt, rec.vs);
+    }
+
     /// Undoes the last collapse (a vertex split); returns it. Quadrics are not restored (they are
     /// only used while simplifying).
     pub fn split_last(&mut self) -> Option<Collapse> {
@@ -262,44 +305,64 @@ impl Hierarchy {
         Some(rec)
     }
 
+    /// The cheapest collapse `vt → w` over the neighbours w of `vt` that passes the checks, and
+    /// whether it is also the cheapest of all (allowed or not).
+    fn best_allowed(&self, vt: u32, strict: bool) -> Option<(f64, u32, bool)> {
+        let mut c: Vec<(f64, u32)> = self.neighbours(vt).iter().map(|&w| (self.cost(vt, w), w)).collect();
+        c.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        c.iter()
+            .enumerate()
+            .find(|(_, &(_, w))| self.can_collapse(vt, w, strict))
+            .map(|(i, &(k, w))| (k, w, i == 0))
+    }
+
+    /// The cheapest collapse cost out of `vt` (allowed or not): the key of its heap entry.
+    fn best_cost(&self, vt: u32) -> f64 {
+        self.neighbours(vt).iter().map(|&w| self.cost(vt, w)).fold(f64::INFINITY, f64::min)
+    }
+
     /// Collapses cheapest-first until `target` vertices remain or nothing more may collapse.
+    ///
+    /// One heap entry per vertex (its cheapest outgoing collapse), not one per half-edge: the heap
+    /// stays V entries instead of growing to millions, which is what made simplification the
+    /// slowest step (cache misses in the sift-down). Entries are invalidated by a per-vertex stamp
+    /// whenever a collapse changes the vertex's quadric or ring.
     pub fn simplify(&mut self, target: usize, strict: bool, progress: &Progress) -> Result<()> {
         let target = target.max(4);
         if self.alive_vertices <= target {
             return Ok(());
         }
         let mut stamp = vec![0u32; self.pos.len()];
-        let mut heap: BinaryHeap<Reverse<(Cost, u32, u32, u32, u32)>> = BinaryHeap::new();
-        for (fi, t) in self.tris.iter().enumerate() {
-            if !self.face_alive[fi] {
-                continue;
-            }
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                heap.push(Reverse((Cost(self.cost(a, b)), a, b, 0, 0)));
+        let mut heap: BinaryHeap<Reverse<(Cost, u32, u32)>> = BinaryHeap::with_capacity(self.pos.len());
+        for v in 0..self.pos.len() as u32 {
+            if self.vertex_alive[v as usize] {
+                heap.push(Reverse((Cost(self.best_cost(v)), v, 0)));
             }
         }
         let start = self.alive_vertices;
         let mut iter = 0usize;
         while self.alive_vertices > target {
-            let Some(Reverse((_, vt, vs, st, ss))) = heap.pop() else { break };
+            let Some(Reverse((Cost(key), vt, st))) = heap.pop() else { break };
             iter += 1;
             if iter % 4096 == 0 {
                 progress.fraction((start - self.alive_vertices) as f64 / (start - target) as f64)?;
             }
-            if stamp[vt as usize] != st || stamp[vs as usize] != ss {
+            if !self.vertex_alive[vt as usize] || stamp[vt as usize] != st {
                 continue;
             }
-            if !self.can_collapse(vt, vs, strict) {
+            // Nothing allowed now: dropped until a collapse nearby changes the vertex's ring.
+            let Some((cost, vs, cheapest)) = self.best_allowed(vt, strict) else { continue };
+            if !cheapest && cost > key {
+                // The cheapest collapse is refused: queue the vertex again at its allowed cost.
+                heap.push(Reverse((Cost(cost), vt, st)));
                 continue;
             }
             self.collapse(vt, vs);
-            // Only the edges at vs changed cost (its quadric grew); entries for other edges stay
-            // valid and are re-checked for collapsibility when popped.
-            stamp[vs as usize] += 1;
-            for w in self.neighbours(vs) {
-                heap.push(Reverse((Cost(self.cost(w, vs)), w, vs, stamp[w as usize], stamp[vs as usize])));
-                heap.push(Reverse((Cost(self.cost(vs, w)), vs, w, stamp[vs as usize], stamp[w as usize])));
+            // The quadric of vs grew and the rings of vs and its neighbours changed: their
+            // cheapest collapses are recomputed.
+            for w in std::iter::once(vs).chain(self.neighbours(vs).iter().copied()) {
+                stamp[w as usize] += 1;
+                heap.push(Reverse((Cost(self.best_cost(w)), w, stamp[w as usize])));
             }
         }
         if !strict && self.alive_vertices > target {

@@ -1,9 +1,7 @@
 //! Rigid and similarity registration (seed 003 §2.1, §4.3): PCA normalisation with a deterministic
 //! axis-sign rule, Procrustes with known correspondences (Horn's quaternion method, seed 003
-//! eq. 2.4), and point-to-plane ICP against a surface (closest points from a BVH, [`surface`]).
+//! eq. 2.4), and point-to-plane ICP against a surface (closest points from the shared BVH, [`crate::spatial::Bvh`]).
 //! Used by the morph job; available to `fit`.
-
-pub mod surface;
 
 use crate::geometry::{add, cross, dot, norm, scale, sub, triangle_area};
 use crate::mesh::Point3;
@@ -282,10 +280,42 @@ pub struct IcpResult {
     pub rms_after: f64,
 }
 
+/// The surface ICP registers onto: the shared closest-point BVH ([`crate::spatial::Bvh`]) and
+/// the unit normal of each triangle (zero for a degenerate one).
+pub struct IcpTarget {
+    bvh: crate::spatial::Bvh,
+    normals: Vec<Point3>,
+}
+
+impl IcpTarget {
+    pub fn new(pos: &[Point3], tris: &[[u32; 3]]) -> IcpTarget {
+        let normals = tris
+            .iter()
+            .map(|t| {
+                let n = cross(
+                    sub(pos[t[1] as usize], pos[t[0] as usize]),
+                    sub(pos[t[2] as usize], pos[t[0] as usize]),
+                );
+                let l = norm(n);
+                if l > 0.0 {
+                    scale(n, 1.0 / l)
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
+        IcpTarget { bvh: crate::spatial::Bvh::new(pos, &crate::mesh::Faces::from_triangles(tris)), normals }
+    }
+
+    fn closest(&self, p: Point3) -> Option<crate::spatial::Closest> {
+        self.bvh.closest(p)
+    }
+}
+
 /// Rigid point-to-plane ICP (seed 003 §2.1; Rusinkiewicz–Levoy's faster-converging metric): pairs
 /// each source point with its closest surface point, solves the linearised 6×6 least-squares
 /// system for a small rotation + translation, repeats until the RMS stops improving.
-pub fn icp(src: &[Point3], target: &surface::SurfaceIndex, max_iterations: usize) -> IcpResult {
+pub fn icp(src: &[Point3], target: &IcpTarget, max_iterations: usize) -> IcpResult {
     let mut total = Similarity::IDENTITY;
     let mut cur: Vec<Point3> = src.to_vec();
     let rms_of = |pts: &[Point3]| -> f64 {
@@ -301,7 +331,7 @@ pub fn icp(src: &[Point3], target: &surface::SurfaceIndex, max_iterations: usize
         let mut atb = [0.0; 6];
         for &p in &cur {
             let Some(h) = target.closest(p) else { continue };
-            let nrm = target.face_normal(h.face);
+            let nrm = target.normals[h.face as usize];
             if dot(nrm, nrm) == 0.0 {
                 continue;
             }
@@ -449,7 +479,7 @@ mod tests {
             *p = [2.0 * p[0], p[1] + 0.3 * p[0] * p[0], 0.6 * p[2]];
         }
         let tris = crate::shapes::fan_triangles(&m.faces);
-        let idx = surface::SurfaceIndex::new(&m.positions, &tris);
+        let idx = IcpTarget::new(&m.positions, &tris);
         let motion =
             Similarity { rotation: rot([0.2, 1.0, 0.1], 0.12), scale: 1.0, translation: [0.05, -0.04, 0.03] };
         let src: Vec<Point3> = m.positions.iter().map(|&p| motion.apply(p)).collect();

@@ -45,7 +45,13 @@ pub fn serve_main(args: ServeArgs) -> Result<(), Failure> {
     let cfg = Config::load(&args).map_err(|m| Failure { code: 2, message: format!("error[config]: {m}") })?;
     let filter = tracing_subscriber::EnvFilter::try_new(&cfg.log)
         .map_err(|e| Failure { code: 2, message: format!("error[config]: log filter: {e}") })?;
-    let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
+    // Colour codes only on a terminal: in a container or a log file they are noise.
+    let ansi = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_ansi(ansi)
+        .with_writer(std::io::stderr)
+        .try_init();
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
