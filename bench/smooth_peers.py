@@ -51,13 +51,13 @@ def bench(path):
         mm = trimesh.Trimesh(V.copy(), m.faces, process=False)
         trimesh.smoothing.filter_laplacian(mm, iterations=1, implicit_time_integration=True)
         return mm
-    dt, _ = best(tri_implicit, reps=1); out.append(("implicit1", "trimesh", dt))
+    dt, _ = best(tri_implicit, reps=1 if big else 5); out.append(("implicit1", "trimesh", dt))
 
     def tri_taubin():
         mm = trimesh.Trimesh(V.copy(), m.faces, process=False)
         trimesh.smoothing.filter_taubin(mm, iterations=10)  # 10 alternating half-steps, operator built inside
         return mm
-    dt, _ = best(tri_taubin); out.append(("taubin10(10 half-steps)", "trimesh", dt))
+    dt, _ = best(tri_taubin, reps=3 if big else 10); out.append(("taubin10(10 half-steps)", "trimesh", dt))
     if o3d is not None:
         mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(V), o3d.utility.Vector3iVector(F.astype(np.int32)))
         dt, _ = best(lambda: mesh.filter_smooth_taubin(number_of_iterations=10)); out.append(("taubin10", "open3d", dt))

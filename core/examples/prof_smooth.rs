@@ -24,6 +24,7 @@ fn main() {
     let (x, f, n) = (&m.positions, &m.faces, m.vertex_count());
     let p = |name: &str, ms: f64| println!("{name:40} {ms:8.2} ms");
     p("stencil edges", best(reps, || Stencil::new(f, n, PairLayout::Edges).unwrap()));
+    p("stencil uniform", best(reps, || Stencil::uniform(f, n).unwrap()));
     let st = Stencil::new(f, n, PairLayout::Edges).unwrap();
     p("uniform_stiffness", best(reps, || st.uniform_stiffness()));
     p("boundary_vertices", best(reps, || st.boundary_vertices()));

@@ -237,6 +237,33 @@ fn compare_reference(
     Comparison { before: b, after: a, flipped_faces: flipped_faces(before, after, faces) }
 }
 
+/// `atan(x)` for `x ≥ 0` (Cephes `atan`: range reduction to |x| ≤ 0.66 and a 4/5 rational
+/// approximation, relative error ~2e-16), about three times cheaper than libm's correctly
+/// rounded `atan2` in the report's one-per-triangle angle.
+#[inline]
+fn atan_nonneg(x: f64) -> f64 {
+    const T3P8: f64 = 2.414_213_562_373_095; // tan(3π/8)
+    const MOREBITS: f64 = 6.123_233_995_736_766e-17;
+    let (base, t, extra) = if x > T3P8 {
+        (std::f64::consts::FRAC_PI_2, -1.0 / x, MOREBITS)
+    } else if x <= 0.66 {
+        (0.0, x, 0.0)
+    } else {
+        (std::f64::consts::FRAC_PI_4, (x - 1.0) / (x + 1.0), 0.5 * MOREBITS)
+    };
+    let z = t * t;
+    let p = (((-8.750_608_600_031_904e-1 * z - 1.615_753_718_733_365e1) * z - 7.500_855_792_314_705e1) * z
+        - 1.228_866_684_490_136e2)
+        * z
+        - 6.485_021_904_942_025e1;
+    let q = ((((z + 2.485_846_490_142_306e1) * z + 1.650_270_098_316_988_5e2) * z + 4.328_810_604_912_903e2)
+        * z
+        + 4.853_903_996_359_137e2)
+        * z
+        + 1.945_506_571_482_614e2;
+    base + (t * (z * p / q) + t) + extra
+}
+
 /// Per-chunk sums of [`compare`] for one state.
 struct TriAcc {
     twice_area: f64,
@@ -287,21 +314,44 @@ impl TriAcc {
         // u·v at each corner; the common |u×v| is `tw`. The smallest angle has the largest dot.
         let d = [dot(e01, e02), -dot(e01, e12), dot(e02, e12)];
         let (dmax, dmin) = (d[0].max(d[1]).max(d[2]), d[0].min(d[1]).min(d[2]));
-        self.sum_min_angle += tw.atan2(dmax);
+        // The smallest angle is at most 60°, so its dot is positive unless the triangle collapsed.
+        self.sum_min_angle += if dmax > 0.0 { atan_nonneg(tw / dmax) } else { tw.atan2(dmax) };
         self.max_cot = self.max_cot.max(cot_key(dmax, tw));
         self.min_cot = self.min_cot.min(cot_key(dmin, tw));
-        // Cotangent Laplacian and Voronoi mass, with the operator's own per-triangle terms.
-        let (cot, vor, _, _) = crate::laplacian::triangle_terms(p);
+        // Cotangent Laplacian (S x) and Voronoi mass: `laplacian::triangle_terms` from the dots
+        // already at hand (cot_q = d_q / tw; same degeneracy rule and Voronoi split).
+        let l2 = [dot(e12, e12), dot(e02, e02), dot(e01, e01)]; // edge opposite corner q
+        let lmax2 = l2[0].max(l2[1]).max(l2[2]);
+        let area = 0.5 * tw;
         let v = [i, j, k];
-        for q in 0..3 {
-            let (a, b) = (v[(q + 1) % 3], v[(q + 2) % 3]);
-            let w = 0.5 * cot[q];
-            let dx = sub(p[(q + 1) % 3], p[(q + 2) % 3]);
-            for r in 0..3 {
-                self.hm[a][r] += w * dx[r];
-                self.hm[b][r] -= w * dx[r];
+        if !(tw > crate::laplacian::DEGENERATE_SHAPE * lmax2) {
+            for q in 0..3 {
+                self.hm[v[q]][3] += area / 3.0;
             }
-            self.hm[v[q]][3] += vor[q];
+            return c;
+        }
+        let inv = 1.0 / tw;
+        let cot = [d[0] * inv, d[1] * inv, d[2] * inv];
+        let obtuse = dmin < 0.0;
+        for q in 0..3 {
+            let (a, b) = ((q + 1) % 3, (q + 2) % 3);
+            // ½Σ cot(opposite)·(x_q − x_other) over the two edges at corner q.
+            let (wa, wb) = (0.5 * cot[b], 0.5 * cot[a]);
+            let (da, db) = (sub(p[q], p[a]), sub(p[q], p[b]));
+            let vor = if obtuse {
+                if cot[q] < 0.0 {
+                    area / 2.0
+                } else {
+                    area / 4.0
+                }
+            } else {
+                (l2[a] * cot[a] + l2[b] * cot[b]) / 8.0
+            };
+            let h = &mut self.hm[v[q]];
+            h[0] += wa * da[0] + wb * db[0];
+            h[1] += wa * da[1] + wb * db[1];
+            h[2] += wa * da[2] + wb * db[2];
+            h[3] += vor;
         }
         c
     }
@@ -466,5 +516,18 @@ mod tests {
         let a = angle_stats(&p, &f);
         assert_eq!((q.before.angles.min, q.before.angles.max), (0.0, 180.0));
         assert!(close(q.before.angles.mean_min, a.mean_min) && a.min == 0.0 && a.max == 180.0);
+    }
+
+    #[test]
+    fn fast_atan_matches_libm() {
+        let mut worst = 0.0f64;
+        for k in 0..=200_000 {
+            let x = k as f64 * 1e-4; // 0 … 20, across the three reduction ranges
+            worst = worst.max((atan_nonneg(x) - x.atan()).abs());
+        }
+        for x in [1e-300, 1e-8, 0.66, 0.660_000_1, 2.414_213_562_373_095, 1e8, 1e300, f64::INFINITY] {
+            worst = worst.max((atan_nonneg(x) - x.atan()).abs());
+        }
+        assert!(worst < 5e-16, "{worst}");
     }
 }

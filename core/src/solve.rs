@@ -119,21 +119,110 @@ pub struct CgInfo {
 /// Jacobi-preconditioned CG on `k` ≤ 4 interleaved columns (x[i*k + c]); `x` holds the initial
 /// guess and receives the solution. Stops when every column's ‖r‖ ≤ tol·‖b‖ or after `max_iter`.
 pub fn pcg(a: &Csr, b: &[f64], x: &mut [f64], k: usize, tol: f64, max_iter: usize) -> CgInfo {
+    assert!(b.len() == a.n * k && x.len() == a.n * k, "pcg: sizes");
+    match k {
+        1 => pcg_k::<1>(a, b, x, tol, max_iter),
+        2 => pcg_k::<2>(a, b, x, tol, max_iter),
+        3 => pcg_k::<3>(a, b, x, tol, max_iter),
+        4 => pcg_k::<4>(a, b, x, tol, max_iter),
+        _ => panic!("pcg supports 1 to 4 interleaved columns"),
+    }
+}
+
+/// Below this many rows CG runs on the calling thread: a 35k-vertex solve is ~1 ms per
+/// iteration, where three fork-joins per iteration cost more than they save on a busy machine.
+const CG_PAR_ROWS: usize = 50_000;
+
+/// Per-column sums of a row pass.
+type Sums<const K: usize> = ([f64; K], [f64; K]);
+
+fn add_sums<const K: usize>(mut a: Sums<K>, b: Sums<K>) -> Sums<K> {
+    for c in 0..K {
+        a.0[c] += b.0[c];
+        a.1[c] += b.1[c];
+    }
+    a
+}
+
+/// Runs `f(i, u_i, v_i, w_i)` over the rows of three `K`-interleaved vectors and sums what it
+/// returns, in parallel for large systems.
+fn row_pass3<const K: usize, F>(par: bool, u: &mut [f64], v: &mut [f64], w: &mut [f64], f: F) -> Sums<K>
+where
+    F: Fn(usize, &mut [f64], &mut [f64], &mut [f64]) -> Sums<K> + Sync + Send,
+{
+    let zero = ([0.0; K], [0.0; K]);
+    if par {
+        u.par_chunks_mut(K)
+            .zip(v.par_chunks_mut(K))
+            .zip(w.par_chunks_mut(K))
+            .enumerate()
+            .with_min_len(4096)
+            .map(|(i, ((u, v), w))| f(i, u, v, w))
+            .reduce(|| zero, add_sums)
+    } else {
+        u.chunks_mut(K)
+            .zip(v.chunks_mut(K))
+            .zip(w.chunks_mut(K))
+            .enumerate()
+            .map(|(i, ((u, v), w))| f(i, u, v, w))
+            .fold(zero, add_sums)
+    }
+}
+
+/// [`row_pass3`] over one vector.
+fn row_pass1<const K: usize, F>(par: bool, u: &mut [f64], f: F) -> Sums<K>
+where
+    F: Fn(usize, &mut [f64]) -> Sums<K> + Sync + Send,
+{
+    let zero = ([0.0; K], [0.0; K]);
+    if par {
+        u.par_chunks_mut(K).enumerate().with_min_len(4096).map(|(i, u)| f(i, u)).reduce(|| zero, add_sums)
+    } else {
+        u.chunks_mut(K).enumerate().map(|(i, u)| f(i, u)).fold(zero, add_sums)
+    }
+}
+
+/// CG with the vector updates and dot products fused into three row passes per iteration
+/// (A·p with p·Ap; x, r, z with r·r and r·z; p), in fixed-size column arrays.
+fn pcg_k<const K: usize>(a: &Csr, b: &[f64], x: &mut [f64], tol: f64, max_iter: usize) -> CgInfo {
     let n = a.n;
+    let par = n >= CG_PAR_ROWS;
     let inv_diag: Vec<f64> = a.diagonal().iter().map(|&d| if d > 0.0 { 1.0 / d } else { 1.0 }).collect();
-    let mut r = vec![0.0; n * k];
-    a.mul_vec(x, &mut r, k);
-    r.par_iter_mut().zip(b).with_min_len(8192).for_each(|(r, b)| *r = b - *r);
-    let bnorm = col_norms(b, k);
+    let row_mul = |i: usize, v: &[f64]| -> [f64; K] {
+        let (s, e) = (a.row_ptr[i] as usize, a.row_ptr[i + 1] as usize);
+        let mut acc = [0.0; K];
+        for (&j, &aij) in a.col[s..e].iter().zip(&a.val[s..e]) {
+            for c in 0..K {
+                acc[c] += aij * v[j as usize * K + c];
+            }
+        }
+        acc
+    };
+    let (mut r, mut z, mut p) = (vec![0.0; n * K], vec![0.0; n * K], vec![0.0; n * K]);
+    let mut ap = vec![0.0; n * K];
+    // r = b − A x, z = p = M⁻¹ r; sums r·r and r·z.
+    let xs: &[f64] = x;
+    let (mut rr, mut rz) = row_pass3::<K, _>(par, &mut r, &mut z, &mut p, |i, r, z, p| {
+        let ax = row_mul(i, xs);
+        let mut s = ([0.0; K], [0.0; K]);
+        for c in 0..K {
+            r[c] = b[i * K + c] - ax[c];
+            z[c] = r[c] * inv_diag[i];
+            p[c] = z[c];
+            s.0[c] = r[c] * r[c];
+            s.1[c] = r[c] * z[c];
+        }
+        s
+    });
+    let mut bb = [0.0; K];
+    for (q, v) in b.iter().enumerate() {
+        bb[q % K] += v * v;
+    }
+    let bnorm: Vec<f64> = bb.iter().map(|v| v.sqrt()).collect();
     let target: Vec<f64> = bnorm.iter().map(|&bn| tol * bn.max(f64::MIN_POSITIVE)).collect();
-    let mut z: Vec<f64> =
-        r.par_iter().enumerate().with_min_len(8192).map(|(q, &r)| r * inv_diag[q / k]).collect();
-    let mut p = z.clone();
-    let mut rz = col_dots(&r, &z, k);
-    let mut ap = vec![0.0; n * k];
     let mut info = CgInfo::default();
     for it in 0..=max_iter {
-        let rn = col_norms(&r, k);
+        let rn: Vec<f64> = rr.iter().map(|v| v.sqrt()).collect();
         let done = rn.iter().zip(&target).all(|(r, t)| r <= t);
         info.iterations = it;
         info.relative_residual =
@@ -145,57 +234,48 @@ pub fn pcg(a: &Csr, b: &[f64], x: &mut [f64], k: usize, tol: f64, max_iter: usiz
         if it == max_iter {
             break;
         }
-        a.mul_vec(&p, &mut ap, k);
-        let pap = col_dots(&p, &ap, k);
-        let alpha: Vec<f64> = (0..k).map(|c| if pap[c] > 0.0 { rz[c] / pap[c] } else { 0.0 }).collect();
-        x.par_chunks_mut(k)
-            .zip(r.par_chunks_mut(k))
-            .zip(z.par_chunks_mut(k))
-            .zip(p.par_chunks(k).zip(ap.par_chunks(k)))
-            .enumerate()
-            .with_min_len(4096)
-            .for_each(|(i, (((x, r), z), (p, ap)))| {
-                for c in 0..k {
-                    x[c] += alpha[c] * p[c];
-                    r[c] -= alpha[c] * ap[c];
-                    z[c] = r[c] * inv_diag[i];
-                }
-            });
-        let rz_new = col_dots(&r, &z, k);
-        let beta: Vec<f64> = (0..k).map(|c| if rz[c] > 0.0 { rz_new[c] / rz[c] } else { 0.0 }).collect();
-        rz = rz_new;
-        p.par_chunks_mut(k).zip(z.par_chunks(k)).with_min_len(4096).for_each(|(p, z)| {
-            for c in 0..k {
-                p[c] = z[c] + beta[c] * p[c];
+        // Ap and p·Ap.
+        let ps: &[f64] = &p;
+        let (pap, _) = row_pass1::<K, _>(par, &mut ap, |i, ap| {
+            let v = row_mul(i, ps);
+            let mut s = ([0.0; K], [0.0; K]);
+            for c in 0..K {
+                ap[c] = v[c];
+                s.0[c] = ps[i * K + c] * v[c];
             }
+            s
+        });
+        let mut alpha = [0.0; K];
+        for c in 0..K {
+            alpha[c] = if pap[c] > 0.0 { rz[c] / pap[c] } else { 0.0 };
+        }
+        // x += αp, r −= αAp, z = M⁻¹r; sums r·r and r·z.
+        let aps: &[f64] = &ap;
+        let (rr_new, rz_new) = row_pass3::<K, _>(par, x, &mut r, &mut z, |i, x, r, z| {
+            let mut s = ([0.0; K], [0.0; K]);
+            for c in 0..K {
+                x[c] += alpha[c] * ps[i * K + c];
+                r[c] -= alpha[c] * aps[i * K + c];
+                z[c] = r[c] * inv_diag[i];
+                s.0[c] = r[c] * r[c];
+                s.1[c] = r[c] * z[c];
+            }
+            s
+        });
+        let mut beta = [0.0; K];
+        for c in 0..K {
+            beta[c] = if rz[c] > 0.0 { rz_new[c] / rz[c] } else { 0.0 };
+        }
+        (rr, rz) = (rr_new, rz_new);
+        let zs: &[f64] = &z;
+        row_pass1::<K, _>(par, &mut p, |i, p| {
+            for c in 0..K {
+                p[c] = zs[i * K + c] + beta[c] * p[c];
+            }
+            ([0.0; K], [0.0; K])
         });
     }
     info
-}
-
-fn col_dots(a: &[f64], b: &[f64], k: usize) -> Vec<f64> {
-    a.par_chunks(k * 1024)
-        .zip(b.par_chunks(k * 1024))
-        .map(|(a, b)| {
-            let mut s = vec![0.0; k];
-            for (q, (x, y)) in a.iter().zip(b).enumerate() {
-                s[q % k] += x * y;
-            }
-            s
-        })
-        .reduce(
-            || vec![0.0; k],
-            |mut s, t| {
-                for c in 0..k {
-                    s[c] += t[c];
-                }
-                s
-            },
-        )
-}
-
-fn col_norms(a: &[f64], k: usize) -> Vec<f64> {
-    col_dots(a, a, k).into_iter().map(f64::sqrt).collect()
 }
 
 /// Elimination of pinned unknowns from a symmetric system.

@@ -410,6 +410,8 @@ fn beetle_as_one_region_lowers_the_energy_without_flipping_faces() {
     let (d0, d1) = (&r["highlight_deviation_before"], &r["highlight_deviation_after"]);
     assert!(d1["f_diff"].as_f64() < d0["f_diff"].as_f64());
     assert!(r["max_step_bound_use"].as_f64().unwrap() <= 1.0 + 1e-12);
+    // No triangle loses more than half of its smallest angle, so neither does the worst one.
+    assert!(r["min_angle_after"].as_f64().unwrap() >= 0.5 * r["min_angle_before"].as_f64().unwrap());
 }
 
 #[test]

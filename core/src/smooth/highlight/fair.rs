@@ -13,11 +13,12 @@
 //! - A step is accepted only if the true (non-approximated) target decreased; otherwise it is
 //!   halved, up to `MAX_HALVINGS` times, and iterations stop when no halving helps. A step that
 //!   would flip a triangle (turn its normal by more than 90° from the previous step or from the
-//!   input) is halved the same way (the ½-edge bound does not rule flips out).
+//!   input) or shrink a triangle's smallest angle below half its input value is halved the same
+//!   way (the ½-edge bound does not rule flips out, and coarse meshes can collapse triangles).
 //! - `f_fair` keeps the printed eq. 8 (`1/Aᵢ`, not `1/(2Aᵢ)`), so `‖K‖² = 16H²`.
 
 use crate::error::Result;
-use crate::geometry::{add, cross, dist, dot, norm, scale, sub};
+use crate::geometry::{add, corner_angle, cross, dist, dot, norm, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -27,6 +28,8 @@ use super::target::{self, Runs};
 
 /// Halvings tried when a step flips a triangle or does not lower the target.
 pub const MAX_HALVINGS: usize = 6;
+/// A step may not shrink any triangle's smallest angle below this fraction of its input value.
+pub const MIN_ANGLE_KEPT: f64 = 0.5;
 
 /// Which vertices move and what the energies sum over (fixed for the whole job).
 #[derive(Debug, Clone)]
@@ -394,6 +397,7 @@ pub struct Outcome {
     pub x: Vec<Point3>,
     pub steps: Vec<Step>,
     pub stop_reason: &'static str,
+    /// Trial steps rejected for flipping or degrading a triangle.
     pub flips_prevented: usize,
     /// Largest |xᵢ| / boundᵢ of any applied step (≤ 1 by construction).
     pub max_bound_use: f64,
@@ -449,7 +453,10 @@ pub fn iterate(
             let trial = moved(&x, &nrm, setup, &step, scale_f);
             // Against the previous step and against the input: a face may not turn by more than
             // 90° in one step nor accumulate that over several.
-            if flips(adj, &x, &trial, setup) || flips(adj, x0, &trial, setup) {
+            if flips(adj, &x, &trial, setup)
+                || flips(adj, x0, &trial, setup)
+                || degrades(adj, x0, &trial, setup)
+            {
                 out.flips_prevented += 1;
             } else {
                 let st = State::new(adj, &trial, setup);
@@ -510,6 +517,22 @@ fn flips(adj: &Adjacency, before: &[Point3], after: &[Point3], setup: &Setup) ->
             let n0 = cross(sub(before[b], before[a]), sub(before[c], before[a]));
             let n1 = cross(sub(after[b], after[a]), sub(after[c], after[a]));
             dot(n0, n1) <= 0.0
+        })
+    })
+}
+
+/// True when a triangle around a movable vertex lost more than half of its smallest angle
+/// relative to the input (moves along normals can collapse triangles of coarse meshes; the paper
+/// does not guard against it).
+fn degrades(adj: &Adjacency, input: &[Point3], after: &[Point3], setup: &Setup) -> bool {
+    let min_angle = |x: &[Point3], t: [u32; 3]| {
+        let [a, b, c] = t.map(|i| x[i as usize]);
+        corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b))
+    };
+    setup.vars.iter().any(|&v| {
+        adj.vert_tris[v as usize].iter().any(|&t| {
+            let t = adj.tris[t as usize];
+            min_angle(after, t) < MIN_ANGLE_KEPT * min_angle(input, t)
         })
     })
 }

@@ -309,7 +309,7 @@ pub fn run(mesh: Mesh, p: &SmoothParams, progress: &Progress) -> Result<Output> 
             "iterations": outcome.steps.len(),
             "stop_reason": outcome.stop_reason,
             "history": outcome.steps,
-            "flips_prevented": outcome.flips_prevented,
+            "steps_halved_for_shape": outcome.flips_prevented,
             "max_step_bound_use": outcome.max_bound_use,
             "highlight_before": summary(&before),
             "highlight_after": summary(&after),
