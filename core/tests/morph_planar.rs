@@ -479,3 +479,24 @@ fn sphere_pseudo_metamesh_reports_both_end_frames() {
     assert!(h_first < 0.05, "{h_first}");
     let _ = dot;
 }
+
+#[test]
+fn three_disks_chain_through_the_common_rim() {
+    let inputs = vec![disk(10), hemisphere(8, 20), paraboloid(13)];
+    let out = job::run(
+        JobKind::Morph,
+        inputs.clone(),
+        serde_json::json!({"registration": "none", "frames": 5, "planar_method": "tutte"}),
+        &Progress::new(),
+    )
+    .expect("three-way planar morph");
+    let r = &out.report;
+    assert_eq!(r["correspondence"], "overlay", "{}", r["correspondence_fallback"]);
+    assert_eq!(r["foldovers"], serde_json::json!([0, 0, 0]));
+    assert_eq!(r["per_input"][1]["parameterisation"]["method"], "tutte");
+    assert_eq!(out.meshes.len(), 3);
+    for k in 0..3 {
+        let h = hausdorff(&out.meshes[k], &inputs[k]);
+        assert!(h <= 1e-3, "input {k}: {h}");
+    }
+}
