@@ -316,9 +316,16 @@ impl Hierarchy {
             .map(|(i, &(k, w))| (k, w, i == 0))
     }
 
-    /// The cheapest collapse cost out of `vt` (allowed or not): the key of its heap entry.
-    fn best_cost(&self, vt: u32) -> f64 {
-        self.neighbours(vt).iter().map(|&w| self.cost(vt, w)).fold(f64::INFINITY, f64::min)
+    /// The cheapest collapse out of `vt` (allowed or not), as (cost, other end): the key of its
+    /// heap entry.
+    fn best_of(&self, vt: u32) -> (f64, u32) {
+        self.neighbours(vt).iter().map(|&w| (self.cost(vt, w), w)).fold((f64::INFINITY, u32::MAX), |a, b| {
+            if b.0 < a.0 {
+                b
+            } else {
+                a
+            }
+        })
     }
 
     /// Collapses cheapest-first until `target` vertices remain or nothing more may collapse.
@@ -332,11 +339,18 @@ impl Hierarchy {
         if self.alive_vertices <= target {
             return Ok(());
         }
-        let mut stamp = vec![0u32; self.pos.len()];
-        let mut heap: BinaryHeap<Reverse<(Cost, u32, u32)>> = BinaryHeap::with_capacity(self.pos.len());
-        for v in 0..self.pos.len() as u32 {
+        let n = self.pos.len();
+        let mut stamp = vec![0u32; n];
+        // best[v]: v's cheapest collapse (cost, other end); live[v]: the key of v's valid heap
+        // entry, NaN when v has none (dropped because nothing was allowed).
+        let mut best = vec![(f64::INFINITY, u32::MAX); n];
+        let mut live = vec![f64::NAN; n];
+        let mut heap: BinaryHeap<Reverse<(Cost, u32, u32)>> = BinaryHeap::with_capacity(n);
+        for v in 0..n as u32 {
             if self.vertex_alive[v as usize] {
-                heap.push(Reverse((Cost(self.best_cost(v)), v, 0)));
+                best[v as usize] = self.best_of(v);
+                live[v as usize] = best[v as usize].0;
+                heap.push(Reverse((Cost(live[v as usize]), v, 0)));
             }
         }
         let start = self.alive_vertices;
@@ -351,18 +365,45 @@ impl Hierarchy {
                 continue;
             }
             // Nothing allowed now: dropped until a collapse nearby changes the vertex's ring.
-            let Some((cost, vs, cheapest)) = self.best_allowed(vt, strict) else { continue };
+            let Some((cost, vs, cheapest)) = self.best_allowed(vt, strict) else {
+                live[vt as usize] = f64::NAN;
+                continue;
+            };
             if !cheapest && cost > key {
                 // The cheapest collapse is refused: queue the vertex again at its allowed cost.
                 heap.push(Reverse((Cost(cost), vt, st)));
+                live[vt as usize] = cost;
                 continue;
             }
             self.collapse(vt, vs);
-            // The quadric of vs grew and the rings of vs and its neighbours changed: their
-            // cheapest collapses are recomputed.
-            for w in std::iter::once(vs).chain(self.neighbours(vs).iter().copied()) {
-                stamp[w as usize] += 1;
-                heap.push(Reverse((Cost(self.best_cost(w)), w, stamp[w as usize])));
+            // The quadric of vs grew: its collapses are recomputed. Of each neighbour w's
+            // collapses only w → vs changed cost (and w → vt is gone), so w's best is updated
+            // from that one edge unless it pointed at vt or vs. An entry is (re)queued when the
+            // key changes or w had none (its ring changed, so something may be allowed now).
+            let b = self.best_of(vs);
+            best[vs as usize] = b;
+            stamp[vs as usize] += 1;
+            live[vs as usize] = b.0;
+            heap.push(Reverse((Cost(b.0), vs, stamp[vs as usize])));
+            for w in self.neighbours(vs).iter().copied() {
+                let wi = w as usize;
+                let old = best[wi];
+                let b = if old.1 == vs || old.1 == vt {
+                    self.best_of(w)
+                } else {
+                    let c = self.cost(w, vs);
+                    if c < old.0 {
+                        (c, vs)
+                    } else {
+                        old
+                    }
+                };
+                best[wi] = b;
+                if live[wi] != b.0 {
+                    stamp[wi] += 1;
+                    live[wi] = b.0;
+                    heap.push(Reverse((Cost(b.0), w, stamp[wi])));
+                }
             }
         }
         if !strict && self.alive_vertices > target {
