@@ -109,7 +109,28 @@ impl Bvh {
         if self.tris.is_empty() {
             return None;
         }
-        let mut best = Closest { point: p, face: u32::MAX, dist2: f64::INFINITY };
+        let mut slot = 0;
+        Some(self.closest_search(p, Closest { point: p, face: u32::MAX, dist2: f64::INFINITY }, &mut slot))
+    }
+
+    /// [`Bvh::closest`] starting from a guess: `hint` is an index into this BVH's triangles (the
+    /// `slot` of an earlier answer). The guess only tightens the initial bound, so the answer is
+    /// the same; for a run of nearby query points (the previous answer's slot as hint) most of
+    /// the tree is pruned at once.
+    pub fn closest_hinted(&self, p: Point3, hint: u32) -> Option<(Closest, u32)> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let h = (hint as usize).min(self.tris.len() - 1);
+        let q = closest_on_triangle(p, &self.tris[h]);
+        let start = Closest { point: q, face: self.face_of[h], dist2: dot(sub(q, p), sub(q, p)) };
+        let mut slot = h as u32;
+        let best = self.closest_search(p, start, &mut slot);
+        Some((best, slot))
+    }
+
+    fn closest_search(&self, p: Point3, start: Closest, slot: &mut u32) -> Closest {
+        let mut best = start;
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
         while let Some(ni) = stack.pop() {
@@ -123,6 +144,7 @@ impl Bvh {
                     let d = dot(sub(q, p), sub(q, p));
                     if d < best.dist2 {
                         best = Closest { point: q, face: self.face_of[t as usize], dist2: d };
+                        *slot = t;
                     }
                 }
             } else {
@@ -138,7 +160,7 @@ impl Bvh {
                 }
             }
         }
-        Some(best)
+        best
     }
 
     /// Largest distance from any of `points` to the surface (0 for no points or no faces).
@@ -239,6 +261,22 @@ mod tests {
     use super::*;
     use crate::geometry::norm;
     use crate::shapes::{grid, icosphere};
+
+    #[test]
+    fn hinted_query_gives_the_same_distance_as_the_plain_one() {
+        // Any hint, good or bad, only changes where the search starts.
+        let m = icosphere(3, 1.0);
+        let bvh = Bvh::new(&m.positions, &m.faces);
+        let mut slot = 0;
+        for k in 0..200 {
+            let t = k as f64 * 0.37;
+            let p = [1.3 * t.cos(), 0.9 * (1.7 * t).sin(), 0.5 * t.sin()];
+            let a = bvh.closest(p).unwrap();
+            let (b, s) = bvh.closest_hinted(p, if k % 3 == 0 { 17 * k } else { slot }).unwrap();
+            slot = s;
+            assert_eq!(a.dist2, b.dist2, "query {k}");
+        }
+    }
 
     #[test]
     fn closest_point_regions_of_a_triangle() {

@@ -118,3 +118,72 @@ fn seg_dist(p: Point3, a: Point3, b: Point3) -> f64 {
     let t = (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1] + (p[2] - a[2]) * ab[2]) / l2).clamp(0.0, 1.0);
     ((0..3).map(|k| (a[k] + t * ab[k] - p[k]).powi(2)).sum::<f64>()).sqrt()
 }
+
+/// The template's UVs follow the fit: old vertices keep theirs, every vertex the fit adds gets the
+/// barycentric interpolation of its template face's UVs where it was made. With the UVs an affine
+/// function of the template position (hand-chosen, invertible), mapping each output vertex's UV
+/// back gives where it sits in the template; the output faces drawn there must tile the unit
+/// square exactly once (all positively oriented, total area 1): no gap, no fold, no overlap.
+#[test]
+fn uvs_are_carried_to_new_vertices() {
+    let (a, b, c, d) = (2.0, -0.5, 0.25, -1.0); // uv = (0.3 + a x + b y, 1 + c x + d y)
+    let uv_of = |p: Point3| [0.3 + a * p[0] + b * p[1], 1.0 + c * p[0] + d * p[1]];
+    let det = a * d - b * c;
+    let back = |uv: [f64; 2]| {
+        let (u, v) = (uv[0] - 0.3, uv[1] - 1.0);
+        [(d * u - b * v) / det, (a * v - c * u) / det]
+    };
+    let mut template = grid(24, 24, 1.0 / 24.0, false);
+    template.uvs = Some(template.positions.iter().map(|&p| uv_of(p)).collect());
+    let out = run(vec![template.clone(), curves()], &params(), &Progress::new()).unwrap();
+    let m = &out.meshes[0];
+    assert!(m.vertex_count() > template.vertex_count(), "the fit added vertices");
+    let uvs = m.uvs.as_ref().expect("output keeps the UVs");
+    assert_eq!(uvs.len(), m.vertex_count());
+    assert_eq!(&uvs[..template.vertex_count()], &template.uvs.as_ref().unwrap()[..]);
+    let q: Vec<[f64; 2]> = uvs.iter().map(|&uv| back(uv)).collect();
+    let mut total = 0.0;
+    for f in m.faces.iter() {
+        let (p0, p1, p2) = (q[f[0] as usize], q[f[1] as usize], q[f[2] as usize]);
+        let area = 0.5 * ((p1[0] - p0[0]) * (p2[1] - p0[1]) - (p2[0] - p0[0]) * (p1[1] - p0[1]));
+        assert!(area > 0.0, "face {f:?} is folded in UV space");
+        total += area;
+    }
+    assert!((total - 1.0).abs() < 1e-9, "UV-space area {total}");
+    // And they reach the file: OBJ written with `vt` and read back.
+    let bytes = meshwork_core::io::write(m, meshwork_core::io::Format::Obj).unwrap();
+    let read = meshwork_core::io::read(&bytes, &Default::default()).unwrap().mesh;
+    assert_eq!(read.uvs.as_ref().map(|u| u.len()), Some(m.vertex_count()));
+}
+
+/// The template's face groups survive as region × group: the grid's left half is group "left",
+/// the right half "right"; the line and the circle (which straddles x = 1/2) make 3 regions, each
+/// on both halves: 6 output groups, and every output face lying in one half carries that half's
+/// name (hand truth from its corner positions; no smoothing, so nothing moves afterwards).
+#[test]
+fn template_groups_are_intersected_with_regions() {
+    let g = grid(24, 24, 1.0 / 24.0, false);
+    let tris: Vec<[u32; 3]> = g.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let mut faces = meshwork_core::mesh::Faces::new();
+    for t in &tris {
+        let cx = t.iter().map(|&v| g.positions[v as usize][0]).sum::<f64>() / 3.0;
+        faces.push(t, (cx > 0.5) as u32);
+    }
+    let mut template = Mesh::new(g.positions.clone(), faces);
+    template.groups = vec!["left".into(), "right".into()];
+    let params = FitParams { smooth: false, ..params() };
+    let out = run(vec![template, curves()], &params, &Progress::new()).unwrap();
+    assert_eq!(out.report["regions"], 3);
+    let m = &out.meshes[0];
+    assert_eq!(m.groups.len(), 6, "{:?}", m.groups);
+    for (i, f) in m.faces.iter().enumerate() {
+        let xs: Vec<f64> = f.iter().map(|&v| m.positions[v as usize][0]).collect();
+        let name = m.group_name(m.faces.group(i));
+        if xs.iter().all(|&x| x <= 0.5) && xs.iter().any(|&x| x < 0.5) {
+            assert!(name.ends_with("/left"), "face {i} at x {xs:?} is in {name}");
+        }
+        if xs.iter().all(|&x| x >= 0.5) && xs.iter().any(|&x| x > 0.5) {
+            assert!(name.ends_with("/right"), "face {i} at x {xs:?} is in {name}");
+        }
+    }
+}

@@ -442,3 +442,13 @@ fn the_result_does_not_depend_on_the_model_scale() {
     }
     assert_eq!(a.report["iterations"], b.report["iterations"]);
 }
+
+#[test]
+fn a_region_too_large_for_a_local_method_is_refused() {
+    // 240 × 240 cells: 235² movable vertices > 50,000.
+    let m = grid(240, 240, 0.01, false);
+    match smooth_err(&m, json!({"method": "highlight", "region_all": true})) {
+        Error::TooLarge { limit, actual, .. } => assert!(actual > limit && limit == 50_000),
+        other => panic!("{other:?}"),
+    }
+}

@@ -14,7 +14,8 @@
 //!
 //! Rules: a foot within `VERTEX_SNAP` (barycentric) of a free template vertex reuses it; within
 //! `EDGE_SNAP` of an edge it splits that edge (both faces, no T-junction); otherwise it splits its
-//! face 1→3. A foot at an already claimed vertex is nudged towards the centre of its face so no
+//! face 1→3. Both snaps avoid slivers but move the curve vertex's pre-image, so they are allowed
+//! only within a quarter of the curve's local segment length (dense curves get exact feet). A foot at an already claimed vertex is nudged towards the centre of its face so no
 //! two RBF centres coincide. Feature points go first so they get the exact vertex at crossings.
 
 use std::collections::HashMap;
@@ -83,6 +84,15 @@ pub fn insert_curve_points(
         vop[p as usize] = v;
         claimed[v as usize] = true;
     }
+    // Shortest segment at each curve point: a snap may move the point's template vertex by at most
+    // a quarter of it, or dense curves would swap order on the surface.
+    let mut spacing = vec![f64::INFINITY; n];
+    for s in &net.segments {
+        let l = dist(net.points[s[0] as usize], net.points[s[1] as usize]);
+        for &p in s {
+            spacing[p as usize] = spacing[p as usize].min(l);
+        }
+    }
     let mut order: Vec<u32> = (0..n as u32).filter(|&p| vop[p as usize] == u32::MAX).collect();
     order.sort_by(|&a, &b| {
         net.is_feature(b).cmp(&net.is_feature(a)).then(feet[a as usize].2.total_cmp(&feet[b as usize].2))
@@ -127,9 +137,10 @@ pub fn insert_curve_points(
             let t = mesh.tris[c as usize];
             let (imax, lmax) = argmax(l);
             let (imin, lmin) = argmin(l);
+            let max_move = 0.25 * spacing[p as usize];
             if lmax > 1.0 - VERTEX_SNAP {
                 let v = t[imax];
-                if !claimed[v as usize] {
+                if !claimed[v as usize] && dist(mesh.pos[v as usize], x) <= max_move {
                     stats.reused_vertices += 1;
                     break v;
                 }
@@ -149,12 +160,12 @@ pub fn insert_curve_points(
                 }
             }
             let tpos = tri_pos(&mesh, tf);
-            let m = if lmin < EDGE_SNAP {
-                // On the edge opposite imin: the point of that edge at the same ratio.
-                let (a, b) = (t[(imin + 1) % 3], t[(imin + 2) % 3]);
-                let (la, lb) = (l[(imin + 1) % 3], l[(imin + 2) % 3]);
-                let s = lb / (la + lb);
-                let xe = add(scale(mesh.pos[a as usize], 1.0 - s), scale(mesh.pos[b as usize], s));
+            // On the edge opposite imin: the point of that edge at the same ratio.
+            let (a, b) = (t[(imin + 1) % 3], t[(imin + 2) % 3]);
+            let (la, lb) = (l[(imin + 1) % 3], l[(imin + 2) % 3]);
+            let s = lb / (la + lb);
+            let xe = add(scale(mesh.pos[a as usize], 1.0 - s), scale(mesh.pos[b as usize], s));
+            let m = if lmin < EDGE_SNAP && (lmin == 0.0 || dist(xe, x) <= max_move) {
                 stats.edge_splits += 1;
                 split_edge(&mut mesh, a, b, xe, &mut kids, &mut origin)
             } else {

@@ -18,6 +18,7 @@ pub mod align;
 pub mod correspond;
 pub mod curves;
 pub mod flips;
+pub mod groups;
 pub mod insert;
 pub mod kdtree;
 pub mod partition;
@@ -222,6 +223,29 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         }
     })?;
 
+    // The template's own face groups, when it has several, are intersected with the regions.
+    let keep_groups = template.groups.len() > 1
+        && template.faces.iter().map(|f| f.len().saturating_sub(2)).sum::<usize>()
+            == crate::shapes::fan_triangles(&template.faces).len();
+    let fine_groups = if keep_groups {
+        let template_tris = crate::shapes::fan_triangles(&template.faces);
+        let template_groups: Vec<u32> = (0..template.faces.len())
+            .flat_map(|i| {
+                std::iter::repeat_n(template.faces.group(i), template.faces.arity(i).saturating_sub(2))
+            })
+            .collect();
+        groups::after_refinement(
+            &tris,
+            &pos,
+            &template_tris,
+            &template_groups,
+            template.vertex_count(),
+            &parents,
+        )
+    } else {
+        Vec::new()
+    };
+    let fine_tris = if keep_groups { tris.clone() } else { Vec::new() };
     let reference_normals = report::vertex_normals(&fine.positions, &tris);
     let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), tris)?;
     let realised = stages.run(progress, "retriangulate", || {
@@ -253,14 +277,29 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     }
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
-    // Output mesh: one group per region, the curves as vertex chains.
+    // Output mesh: one group per region (per region × template group when the template had
+    // groups), the curves as vertex chains.
     let mut faces = Faces::with_capacity(out_tris.len(), out_tris.len() * 3);
-    for (t, &g) in out_tris.iter().zip(&region) {
-        faces.push(t, g);
+    let mut group_names: Vec<String> = (0..region_count).map(|i| format!("region_{i}")).collect();
+    if keep_groups {
+        let tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
+        let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        group_names.clear();
+        for ((t, &r), &g) in out_tris.iter().zip(&region).zip(&tg) {
+            let gid = *id.entry((r, g)).or_insert_with(|| {
+                group_names.push(format!("region_{r}/{}", template.group_name(g)));
+                (group_names.len() - 1) as u32
+            });
+            faces.push(t, gid);
+        }
+    } else {
+        for (t, &g) in out_tris.iter().zip(&region) {
+            faces.push(t, g);
+        }
     }
     let mut out = Mesh::new(out_pos, faces);
     out.uvs = template.uvs.as_ref().map(|uv| interpolate_uvs(uv, &parents));
-    out.groups = (0..region_count).map(|i| format!("region_{i}")).collect();
+    out.groups = group_names;
     out.curves = report::polyline_chains(&net, &realised.chains);
 
     let quality = stages.run(progress, "quality", || {
@@ -278,6 +317,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "template_vertices": template.vertex_count(),
         "template_faces": template.face_count(),
         "template_triangles": crate::shapes::fan_triangles(&template.faces).len(),
+        "template_groups_kept": if keep_groups { template.groups.len() } else { 0 },
         "output_vertices": out.vertex_count(),
         "output_faces": out.face_count(),
         "curve_vertices": net.points.len(),
@@ -693,6 +733,7 @@ pub fn interpolate_uvs(uv: &[[f64; 2]], parents: &[[(u32, f64); 3]]) -> Vec<[f64
     out
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fine_fit(
     pos: &mut Vec<Point3>,
     tris: &mut Vec<[u32; 3]>,

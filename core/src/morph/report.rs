@@ -7,23 +7,40 @@ use crate::mesh::Faces;
 use crate::mesh::Point3;
 use crate::spatial::Bvh;
 
+/// Max squared distance from `pts` to surface `b`, in parallel chunks; within a chunk each query
+/// starts from the previous answer (the points come in mesh order, so neighbours follow each
+/// other and the hint prunes most of the tree: the overlay has ~10× the inputs' vertices).
+fn max_dist2(pts: &[Point3], b: &Bvh) -> f64 {
+    use rayon::prelude::*;
+    pts.par_chunks(4096)
+        .map(|chunk| {
+            let mut slot = 0;
+            let mut m = 0.0f64;
+            for &p in chunk {
+                if let Some((h, s)) = b.closest_hinted(p, slot) {
+                    slot = s;
+                    m = m.max(h.dist2);
+                }
+            }
+            m
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
 /// One-sided max distance from points (vertices and face centroids of A) to surface B.
 fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &Bvh, centroids: bool) -> f64 {
-    use rayon::prelude::*;
-    let v = pa.par_iter().filter_map(|&p| b.closest(p)).map(|h| h.dist2).reduce(|| 0.0, f64::max);
+    let v = max_dist2(pa, b);
     if !centroids {
         return v.sqrt();
     }
-    let c = ta
-        .par_iter()
+    let c: Vec<Point3> = ta
+        .iter()
         .map(|t| {
             let (x, y, z) = (pa[t[0] as usize], pa[t[1] as usize], pa[t[2] as usize]);
             [(x[0] + y[0] + z[0]) / 3.0, (x[1] + y[1] + z[1]) / 3.0, (x[2] + y[2] + z[2]) / 3.0]
         })
-        .filter_map(|p| b.closest(p))
-        .map(|h| h.dist2)
-        .reduce(|| 0.0, f64::max);
-    v.max(c).sqrt()
+        .collect();
+    v.max(max_dist2(&c, b)).sqrt()
 }
 
 /// Symmetric Hausdorff distance (sampled at vertices and face centroids) between two triangle

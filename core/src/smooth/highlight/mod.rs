@@ -30,6 +30,10 @@ use lines::{Adjacency, Lights};
 pub const DEFAULT_ITERATIONS: u32 = 20;
 /// Default ε of eq. 17 (the paper's value).
 pub const DEFAULT_EPSILON: f64 = 1e-3;
+/// Largest number of movable vertices (QP unknowns) accepted: the QP's Hessian couples two rings,
+/// so memory grows ~50 entries per unknown and the method is meant for local regions (§5 of the
+/// paper: "it may fail when the irregular region is relatively large").
+pub const MAX_UNKNOWNS: usize = 50_000;
 /// With the default spacing, about this many lights cross the region.
 pub const DEFAULT_LINES: f64 = 16.0;
 
@@ -244,6 +248,14 @@ pub fn run(mesh: Mesh, p: &SmoothParams, progress: &Progress) -> Result<Output> 
         }
         let (lights, defaults) = lights(&mesh, &adj, &region, p)?;
         let setup = fair::Setup::new(&adj, &mesh.positions, region, &pinned, lights, w_fair, w_diff, frac);
+        if setup.vars.len() > MAX_UNKNOWNS {
+            return Err(Error::TooLarge {
+                what: "highlight fairing: movable vertices (the method is local; select a smaller region)"
+                    .into(),
+                limit: MAX_UNKNOWNS as u64,
+                actual: setup.vars.len() as u64,
+            });
+        }
         if setup.vars.is_empty() {
             return Err(Error::params(
                 "region",

@@ -179,6 +179,9 @@ pub fn solve_box(
                 break;
             }
             st.cg_iterations += 1;
+            if st.cg_iterations % 256 == 0 {
+                progress.check()?;
+            }
             h.mul(&p, &mut tmp);
             let php = dotv(&p, &tmp);
             if php <= 0.0 {

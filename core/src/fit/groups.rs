@@ -1,0 +1,98 @@
+//! The template's face groups carried to the output: every face the fit makes lies inside one
+//! template face (insertion and subdivision only split faces) or, after re-triangulation, among
+//! faces that did; it keeps that face's group. The output groups are then the intersections
+//! "region_i/<template group>".
+
+use std::collections::HashMap;
+
+use crate::mesh::Point3;
+
+use super::insert::barycentric;
+
+/// Template group of each triangle of `tris` (the fine stage's mesh, positions `pos` before the
+/// fine deformation). `parents[i]` are the weighted parents of vertex `nv0 + i`.
+pub fn after_refinement(
+    tris: &[[u32; 3]],
+    pos: &[Point3],
+    template_tris: &[[u32; 3]],
+    template_groups: &[u32],
+    nv0: usize,
+    parents: &[[(u32, f64); 3]],
+) -> Vec<u32> {
+    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); nv0];
+    for (f, t) in template_tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(f as u32);
+        }
+    }
+    // An original template vertex at or behind each vertex (new vertices: follow a parent with
+    // a non-zero weight back to the template).
+    let root = |mut v: u32| -> u32 {
+        while v as usize >= nv0 {
+            let p = &parents[v as usize - nv0];
+            v = p.iter().find(|x| x.1 > 0.0).map_or(p[0].0, |x| x.0);
+        }
+        v
+    };
+    tris.iter()
+        .map(|t| {
+            let c = [
+                (pos[t[0] as usize][0] + pos[t[1] as usize][0] + pos[t[2] as usize][0]) / 3.0,
+                (pos[t[0] as usize][1] + pos[t[1] as usize][1] + pos[t[2] as usize][1]) / 3.0,
+                (pos[t[0] as usize][2] + pos[t[1] as usize][2] + pos[t[2] as usize][2]) / 3.0,
+            ];
+            let mut best = (f64::NEG_INFINITY, 0u32);
+            for &v in t {
+                for &f in &vf[root(v) as usize] {
+                    let tt = template_tris[f as usize];
+                    let l = barycentric(c, &[pos[tt[0] as usize], pos[tt[1] as usize], pos[tt[2] as usize]]);
+                    let m = l[0].min(l[1]).min(l[2]);
+                    if m > best.0 {
+                        best = (m, template_groups[f as usize]);
+                    }
+                }
+                if best.0 >= -1e-9 {
+                    break;
+                }
+            }
+            best.1
+        })
+        .collect()
+}
+
+/// Groups of the re-triangulated faces: a face that existed before keeps its group; a new one
+/// takes the group most of its corners' old faces have.
+pub fn after_retriangulation(
+    before: &[[u32; 3]],
+    before_groups: &[u32],
+    after: &[[u32; 3]],
+    nv: usize,
+) -> Vec<u32> {
+    let key = |t: &[u32; 3]| {
+        let mut k = *t;
+        k.sort_unstable();
+        k
+    };
+    let old: HashMap<[u32; 3], u32> = before.iter().zip(before_groups).map(|(t, &g)| (key(t), g)).collect();
+    let mut vg: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for (t, &g) in before.iter().zip(before_groups) {
+        for &v in t {
+            vg[v as usize].push(g);
+        }
+    }
+    after
+        .iter()
+        .map(|t| {
+            if let Some(&g) = old.get(&key(t)) {
+                return g;
+            }
+            let mut count: HashMap<u32, usize> = HashMap::new();
+            for &v in t {
+                for &g in &vg[v as usize] {
+                    *count.entry(g).or_default() += 1;
+                }
+            }
+            count.into_iter().max_by_key(|&(g, c)| (c, std::cmp::Reverse(g))).map_or(0, |x| x.0)
+        })
+        .collect()
+}
