@@ -4,8 +4,9 @@
 //! same-run peer comparison of the RBF stage against SciPy's `RBFInterpolator` (same kernel φ = r,
 //! degree-1 polynomial), when the peers venv is installed.
 //!
-//! Run: `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example bench_fit`
-//! (from the repository root; reads `../shared/meshes/homer.obj`).
+//! Run from the repository root (reads `../shared/meshes/homer.obj`) with a private release target dir
+//! (see docs/benchmarks.md → Fit: the shared one mixes worktrees' builds of this example):
+//! `CARGO_TARGET_DIR=/tmp/fit-rel cargo run --release -p meshwork-core --example bench_fit`
 
 use std::time::Instant;
 

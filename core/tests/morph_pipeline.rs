@@ -388,3 +388,40 @@ fn blend_weights_give_the_affine_combination_of_the_remeshed_inputs() {
         }
     }
 }
+
+#[test]
+fn dense_subdivided_shared_mesh_maps_without_foldovers() {
+    // homer after one √3 step: 18,002 vertices of a real model (thin fans on its curved parts).
+    let m = sqrt3(&load("homer.obj"));
+    let (t, _, _) = TriMesh::from_mesh(&m);
+    let f = register::pca_frame(&t.pos, &t.tris).to_normalised;
+    let t = TriMesh { pos: t.pos.iter().map(|&p| f.apply(p)).collect(), tris: t.tris };
+    let s = ParamSettings { working_vertices: 1000, ..settings() };
+    let map = param::parameterise(&t, &s, &Progress::new()).expect("dense homer parameterises");
+    eprintln!("homer √3: {:?}", map.report);
+    assert_eq!(map.report.foldovers, 0);
+    assert_covers_sphere_once("homer √3", &map.sphere, &t.tris);
+    assert!(map.report.angle_distortion <= 0.45 && map.report.area_distortion <= 1.42, "{:?}", map.report);
+}
+
+/// The scanned bunny (5 holes, filled by `repair`) morphed onto homer: 34,834 + 6,002 vertices.
+/// Heavy in the dev profile: `cargo test -p meshwork-core --test morph_pipeline -- --ignored`.
+#[test]
+#[ignore]
+fn dense_scan_morph_after_repair_has_no_foldovers() {
+    let out = job::run(
+        JobKind::Morph,
+        vec![load("stanford-bunny.obj"), load("homer.obj")],
+        serde_json::json!({"repair": true, "frames": 5}),
+        &Progress::new(),
+    )
+    .expect("bunny ↔ homer morphs after repair");
+    let r = &out.report;
+    eprintln!("{}", r["per_input"]);
+    for k in 0..2 {
+        assert_eq!(r["foldovers"][k].as_u64(), Some(0));
+        assert!(r["angle_distortion"][k].as_f64().unwrap() <= 0.45, "{}", r["angle_distortion"]);
+        assert!(r["area_distortion"][k].as_f64().unwrap() <= 1.42, "{}", r["area_distortion"]);
+        assert!(r["hausdorff_per_input"][k].as_f64().unwrap() <= 1e-3, "{}", r["hausdorff_per_input"]);
+    }
+}

@@ -129,6 +129,9 @@ pub enum PlanarMethod {
     Elrp,
     /// Tutte's uniform weights (w_ij = 1), boundary by arc length.
     Tutte,
+    /// Inverse edge length (w_ij = 1/l_ij: Greiner–Hormann r = 1, the reading of eq. IV.44 with
+    /// the proportionality inverted), boundary by arc length.
+    InverseLength,
 }
 
 /// A disk map: lifted plane positions, the boundary loop and each boundary vertex's angle.
@@ -195,6 +198,9 @@ fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod)
             PlanarMethod::Tutte => 1.0,
             // A zero-length edge would give a zero weight (and possibly a singular row).
             PlanarMethod::Elrp => dist(m.pos[a as usize], m.pos[b as usize]).max(1e-9 * mean_len.max(1e-300)),
+            PlanarMethod::InverseLength => {
+                1.0 / dist(m.pos[a as usize], m.pos[b as usize]).max(1e-9 * mean_len.max(1e-300))
+            }
         }
     };
     let nf = nf as usize;
@@ -251,7 +257,12 @@ pub fn parameterise(m: &TriMesh, method: PlanarMethod) -> Result<DiskMap> {
     let lp = boundary_loop(m)?;
     let angles = arc_length_angles(&m.pos, &lp);
     let mut rep = PlanarReport {
-        method: format!("{method:?}").to_lowercase(),
+        method: match method {
+            PlanarMethod::Elrp => "elrp",
+            PlanarMethod::Tutte => "tutte",
+            PlanarMethod::InverseLength => "inverse_length",
+        }
+        .into(),
         boundary_vertices: lp.len(),
         ..Default::default()
     };
@@ -747,7 +758,7 @@ mod tests {
     #[test]
     fn a_flat_disk_maps_without_flips_and_with_its_boundary_on_the_circle() {
         let g = disk(8);
-        for method in [PlanarMethod::Elrp, PlanarMethod::Tutte] {
+        for method in [PlanarMethod::Elrp, PlanarMethod::Tutte, PlanarMethod::InverseLength] {
             let m = parameterise(&g, method).unwrap();
             assert_eq!(m.report.foldovers, 0);
             assert_eq!(m.report.fallback_reason, None);
@@ -769,6 +780,7 @@ mod tests {
                 let w = |u: u32| match method {
                     PlanarMethod::Tutte => 1.0,
                     PlanarMethod::Elrp => dist(g.pos[v], g.pos[u as usize]),
+                    PlanarMethod::InverseLength => 1.0 / dist(g.pos[v], g.pos[u as usize]),
                 };
                 let ws: f64 = nb[v].iter().map(|&u| w(u)).sum();
                 for c in 0..2 {
