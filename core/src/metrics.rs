@@ -153,8 +153,9 @@ pub struct SurfaceQuality {
     /// Signed cone volume from the apex (see [`volume_about`]).
     pub volume: f64,
     pub angles: AngleStats,
-    /// Mass-weighted mean |H| from the cotangent operator with Voronoi mass (see [`mean_curvature`]).
-    pub mean_curvature: f64,
+    /// Mass-weighted mean |H| from the cotangent operator with Voronoi mass (see [`mean_curvature`]);
+    /// `None` when it was not asked for (it needs per-vertex accumulators: the costly part).
+    pub mean_curvature: Option<f64>,
 }
 
 /// A surface before and after a deformation of its vertices (same faces).
@@ -178,9 +179,10 @@ pub fn compare(
     faces: &Faces,
     apex: Point3,
     skip: &[bool],
+    curvature: bool,
 ) -> Comparison {
     let Some(tris) = faces.as_triangles() else {
-        return compare_reference(before, after, faces, apex, skip);
+        return compare_reference(before, after, faces, apex, skip, curvature);
     };
     let n = before.len();
     let nt = tris.len() / 3;
@@ -191,7 +193,7 @@ pub fn compare(
     let parts: Vec<(TriAcc, TriAcc, usize)> = tris
         .par_chunks(3 * per)
         .map(|t| {
-            let (mut a, mut b) = (TriAcc::new(n), TriAcc::new(n));
+            let (mut a, mut b) = (TriAcc::new(n, curvature), TriAcc::new(n, curvature));
             let mut flipped = 0;
             for t in t.chunks_exact(3) {
                 let c0 = a.add(before, t, apex);
@@ -219,19 +221,22 @@ fn compare_reference(
     faces: &Faces,
     apex: Point3,
     skip: &[bool],
+    curvature: bool,
 ) -> Comparison {
     let state = |x: &[Point3]| SurfaceQuality {
         area: area(x, faces),
         volume: volume_about(x, faces, apex),
         angles: angle_stats(x, faces),
-        mean_curvature: crate::laplacian::operator(
-            x,
-            faces,
-            crate::laplacian::OperatorKind::Cotan,
-            crate::laplacian::MassKind::Voronoi,
-        )
-        .map(|op| mean_curvature(&op, x, skip))
-        .unwrap_or(f64::NAN),
+        mean_curvature: curvature.then(|| {
+            crate::laplacian::operator(
+                x,
+                faces,
+                crate::laplacian::OperatorKind::Cotan,
+                crate::laplacian::MassKind::Voronoi,
+            )
+            .map(|op| mean_curvature(&op, x, skip))
+            .unwrap_or(f64::NAN)
+        }),
     };
     let (b, a) = rayon::join(|| state(before), || state(after));
     Comparison { before: b, after: a, flipped_faces: flipped_faces(before, after, faces) }
@@ -272,8 +277,9 @@ struct TriAcc {
     max_cot: f64,
     min_cot: f64,
     sum_min_angle: f64,
-    /// Per vertex: (S x) and the Voronoi mass.
+    /// Per vertex: (S x) and the Voronoi mass; empty when the curvature is not wanted.
     hm: Vec<[f64; 4]>,
+    curvature: bool,
 }
 
 /// Monotone decreasing in the corner angle `atan2(t, d)` (t = |u×v| ≥ 0, d = u·v): its cotangent,
@@ -290,14 +296,15 @@ fn cot_key(d: f64, t: f64) -> f64 {
 }
 
 impl TriAcc {
-    fn new(n: usize) -> TriAcc {
+    fn new(n: usize, curvature: bool) -> TriAcc {
         TriAcc {
             twice_area: 0.0,
             volume6: 0.0,
             max_cot: f64::NEG_INFINITY,
             min_cot: f64::INFINITY,
             sum_min_angle: 0.0,
-            hm: vec![[0.0; 4]; n],
+            hm: if curvature { vec![[0.0; 4]; n] } else { Vec::new() },
+            curvature,
         }
     }
 
@@ -318,6 +325,9 @@ impl TriAcc {
         self.sum_min_angle += if dmax > 0.0 { atan_nonneg(tw / dmax) } else { tw.atan2(dmax) };
         self.max_cot = self.max_cot.max(cot_key(dmax, tw));
         self.min_cot = self.min_cot.min(cot_key(dmin, tw));
+        if !self.curvature {
+            return c;
+        }
         // Cotangent Laplacian (S x) and Voronoi mass: `laplacian::triangle_terms` from the dots
         // already at hand (cot_q = d_q / tw; same degeneracy rule and Voronoi split).
         let l2 = [dot(e12, e12), dot(e02, e02), dot(e01, e01)]; // edge opposite corner q
@@ -395,7 +405,7 @@ impl TriAcc {
             area: 0.5 * self.twice_area,
             volume: self.volume6 / 6.0,
             angles,
-            mean_curvature: if den > 0.0 { num / den } else { 0.0 },
+            mean_curvature: self.curvature.then_some(if den > 0.0 { num / den } else { 0.0 }),
         }
     }
 }
@@ -446,7 +456,7 @@ mod tests {
                 p[0] = -p[0];
             }
             let skip = vec![false; g.vertex_count()];
-            let q = compare(&g.positions, &mirrored, &g.faces, [0.0, 0.0, 1.0], &skip);
+            let q = compare(&g.positions, &mirrored, &g.faces, [0.0, 0.0, 1.0], &skip, true);
             for s in [q.before, q.after] {
                 assert!((s.area - 9.0).abs() < 1e-12, "{s:?}");
                 assert!((s.volume.abs() - 3.0).abs() < 1e-12, "cone of height 1 over area 9: {s:?}");
@@ -466,8 +476,8 @@ mod tests {
                 .unwrap();
         let boundary = st.boundary_vertices();
         assert_eq!(boundary.iter().filter(|b| **b).count(), 20, "the 6×6 sheet's rim");
-        let q = compare(&g.positions, &g.positions, &g.faces, [0.0; 3], &boundary);
-        assert!(q.before.mean_curvature.abs() < 1e-12, "{q:?}");
+        let q = compare(&g.positions, &g.positions, &g.faces, [0.0; 3], &boundary, true);
+        assert!(q.before.mean_curvature.unwrap().abs() < 1e-12, "{q:?}");
         assert!((q.before.angles.min - 60.0).abs() < 1e-12 && (q.before.angles.max - 60.0).abs() < 1e-12);
         assert_eq!(q.flipped_faces, 0);
     }
@@ -487,7 +497,12 @@ mod tests {
         let mut skip = vec![false; x0.len()];
         skip[3] = true;
         let apex = [0.3, -0.2, 0.1];
-        let q = compare(&x0, &x1, &m.faces, apex, &skip);
+        let q = compare(&x0, &x1, &m.faces, apex, &skip, true);
+        // Without curvature: the same triangle measures, no curvature.
+        let lean = compare(&x0, &x1, &m.faces, apex, &skip, false);
+        assert_eq!((lean.before.mean_curvature, lean.after.mean_curvature), (None, None));
+        assert_eq!((lean.before.area, lean.after.volume), (q.before.area, q.after.volume));
+        assert_eq!((lean.before.angles, lean.flipped_faces), (q.before.angles, q.flipped_faces));
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-11 * b.abs().max(1e-300);
         for (s, x) in [(q.before, &x0), (q.after, &x1)] {
             assert!(close(s.area, area(x, &m.faces)));
@@ -499,12 +514,8 @@ mod tests {
                     && close(s.angles.max, a.max)
             );
             let op = operator(x, &m.faces, OperatorKind::Cotan, MassKind::Voronoi).unwrap();
-            assert!(
-                close(s.mean_curvature, mean_curvature(&op, x, &skip)),
-                "{} {}",
-                s.mean_curvature,
-                mean_curvature(&op, x, &skip)
-            );
+            let h = s.mean_curvature.unwrap();
+            assert!(close(h, mean_curvature(&op, x, &skip)), "{} {}", h, mean_curvature(&op, x, &skip));
         }
         assert_eq!(q.flipped_faces, flipped_faces(&x0, &x1, &m.faces));
         // Degenerate triangles: a collinear one (angles 0, 0, 180) and a collapsed one (all 0).
@@ -512,7 +523,7 @@ mod tests {
         let mut f = Faces::new();
         f.push(&[0, 1, 2], 0);
         f.push(&[0, 1, 3], 0);
-        let q = compare(&p, &p, &f, [0.0; 3], &[false; 4]);
+        let q = compare(&p, &p, &f, [0.0; 3], &[false; 4], true);
         let a = angle_stats(&p, &f);
         assert_eq!((q.before.angles.min, q.before.angles.max), (0.0, 180.0));
         assert!(close(q.before.angles.mean_min, a.mean_min) && a.min == 0.0 && a.max == 180.0);

@@ -207,10 +207,15 @@ fn inflation_increases_mean_curvature() {
 #[test]
 fn taubin_keeps_the_bunny_volume_within_one_percent() {
     let Some(m) = bunny() else { return };
-    let out = smooth(&m, json!({"method": "taubin", "iterations": 10}));
+    let out = smooth(&m, json!({"method": "taubin", "iterations": 10, "report_curvature": true}));
     let dv = out.report["volume_change"].as_f64().unwrap();
     assert!(dv.abs() < 0.01, "{dv}");
-    assert!(out.report["mean_curvature_after"].as_f64() < out.report["mean_curvature_before"].as_f64());
+    let h = |k: &str| out.report[k].as_f64().expect("curvature was asked for");
+    assert!(h("mean_curvature_after") < h("mean_curvature_before"));
+    // Not asked for (the default outside `inflate`): reported as null, the rest unchanged.
+    let lean = smooth(&m, json!({"method": "taubin", "iterations": 10}));
+    assert!(lean.report["mean_curvature_after"].is_null());
+    assert_eq!(lean.report["volume_change"], out.report["volume_change"]);
     // Plain Laplacian flow with the same λ and number of steps shrinks it more than Taubin does.
     let lap = smooth(&m, json!({"method": "laplacian", "iterations": 20}));
     assert!(lap.report["volume_change"].as_f64().unwrap() < -dv.abs());

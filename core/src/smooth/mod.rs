@@ -160,7 +160,7 @@ fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
     let f = &mesh.faces;
     let (max_d, mean_d) = metrics::displacement(x0, x);
     // One fused pass over the triangles for both states (areas, volume, angles, flips, curvature).
-    let q = metrics::compare(x0, x, f, ctx.center, &ctx.boundary);
+    let q = metrics::compare(x0, x, f, ctx.center, &ctx.boundary, ctx.r.report_curvature);
     let (a0, a1) = (q.before.angles, q.after.angles);
     let vol1 = q.after.volume;
     let (area0, area1) = (q.before.area, q.after.area);

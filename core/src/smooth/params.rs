@@ -110,6 +110,10 @@ pub struct SmoothParams {
     /// Compute the symmetric Hausdorff distance for the report (default true; costs two
     /// closest-point passes).
     pub hausdorff: Option<bool>,
+    /// Report the mass-weighted mean |H| before and after (`mean_curvature_before/after`). Default:
+    /// only for `inflate`, whose purpose it measures; elsewhere it costs about as much as the other
+    /// report measures together (a per-vertex cotangent pass over both states).
+    pub report_curvature: Option<bool>,
     /// `highlight`: faces whose vertices form the region R (with `region`/`groups`).
     pub region_faces: Vec<u32>,
     /// `highlight`: R = every vertex (the mesh boundary then acts as R's border).
@@ -165,6 +169,7 @@ pub struct Resolved {
     pub order: u32,
     pub mcf_iterations: u32,
     pub hausdorff: bool,
+    pub report_curvature: bool,
 }
 
 fn finite(field: &str, v: f64) -> Result<f64> {
@@ -296,6 +301,7 @@ impl SmoothParams {
             order,
             mcf_iterations,
             hausdorff: self.hausdorff.unwrap_or(true),
+            report_curvature: self.report_curvature.unwrap_or(m == Method::Inflate),
         })
     }
 }
