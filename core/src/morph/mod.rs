@@ -34,7 +34,7 @@ use serde_json::json;
 
 use crate::error::{Error, Result};
 use crate::geometry::signed_volume;
-use crate::job::{Artifact, Output, Progress, Stages};
+use crate::job::{Output, Progress, Stages};
 use crate::mesh::{Faces, Mesh, Point3};
 use crate::register::{self, Similarity};
 
@@ -449,39 +449,13 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         Ok((acc, reps, fallback, pseudo_reps))
     })?;
 
-    // 6. Interpolate, in input 0's coordinates.
+    // Back in input 0's coordinates.
     let back = frames_out[0].inverse();
     let shapes_out: Vec<Vec<Point3>> =
         layer.shapes.iter().map(|s| s.iter().map(|&p| back.apply(p)).collect()).collect();
-    let out_meshes = stages.run(progress, "interpolate", || {
-        let mk = |pos: Vec<Point3>| Mesh::from_triangles(pos, &layer.tris);
-        Ok(if let Some(w) = &params.blend_weights {
-            vec![mk(interpolate::blend(&shapes_out, w))]
-        } else if params.output_frames {
-            (0..params.frames)
-                .map(|j| {
-                    let (leg, t) = interpolate::frame_position(j, params.frames, k_in);
-                    mk(interpolate::frame(&shapes_out, leg, t))
-                })
-                .collect()
-        } else {
-            shapes_out.iter().map(|s| mk(s.clone())).collect()
-        })
-    })?;
-
-    // 7. GLB.
-    let glb_bytes = stages.run(progress, "glb", || {
-        let keys = interpolate::keyframes(params.frames, k_in, params.duration_seconds);
-        glb::write(&layer.tris, &shapes_out, &keys)
-    })?;
-    let mut artifacts =
-        vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }];
-    if let Some(fmt) = params.frames_zip {
-        let z = stages.run(progress, "frames_zip", || {
-            output::frames_zip(&layer.tris, &shapes_out, params.frames, fmt, progress)
-        })?;
-        artifacts.insert(0, z);
-    }
+    // 6–7. Interpolate, GLB (and the frames ZIP when asked for).
+    let (out_meshes, artifacts) =
+        output::write_outputs(&mut stages, progress, params, &layer.tris, &shapes_out)?;
 
     // 8. Report: how well the end frames reproduce the inputs (in the normalised frames).
     let hausdorff = stages.run(progress, "report", || {

@@ -4,10 +4,51 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::io::zip::ZipWriter;
-use crate::job::{Artifact, Progress};
+use crate::job::{Artifact, Progress, Stages};
 use crate::mesh::{Mesh, Point3};
 
-use super::{glb, interpolate};
+use super::{glb, interpolate, MorphParams};
+
+/// The stages every domain ends with, on the common connectivity `tris` and the per-input shapes
+/// (already in input 0's coordinates): the output meshes (`interpolate`: blend, frames or the end
+/// shapes, as the params ask), the animated GLB (`glb`) and, on request, the frames ZIP
+/// (`frames_zip`, then first among the artifacts: it is the result file).
+pub fn write_outputs(
+    stages: &mut Stages,
+    progress: &Progress,
+    params: &MorphParams,
+    tris: &[[u32; 3]],
+    shapes: &[Vec<Point3>],
+) -> Result<(Vec<Mesh>, Vec<Artifact>)> {
+    let k_in = shapes.len();
+    let meshes = stages.run(progress, "interpolate", || {
+        let mk = |pos: Vec<Point3>| Mesh::from_triangles(pos, tris);
+        Ok(if let Some(w) = &params.blend_weights {
+            vec![mk(interpolate::blend(shapes, w))]
+        } else if params.output_frames {
+            (0..params.frames)
+                .map(|j| {
+                    let (leg, t) = interpolate::frame_position(j, params.frames, k_in);
+                    mk(interpolate::frame(shapes, leg, t))
+                })
+                .collect()
+        } else {
+            shapes.iter().map(|s| mk(s.clone())).collect()
+        })
+    })?;
+    let glb_bytes = stages.run(progress, "glb", || {
+        let keys = interpolate::keyframes(params.frames, k_in, params.duration_seconds);
+        glb::write(tris, shapes, &keys)
+    })?;
+    let mut artifacts =
+        vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }];
+    if let Some(fmt) = params.frames_zip {
+        let z =
+            stages.run(progress, "frames_zip", || frames_zip(tris, shapes, params.frames, fmt, progress))?;
+        artifacts.insert(0, z);
+    }
+    Ok((meshes, artifacts))
+}
 
 /// File format of each frame in the `frames_zip` output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, utoipa::ToSchema)]

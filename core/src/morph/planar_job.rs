@@ -25,7 +25,7 @@ use super::planar::{self, DiskMap};
 use super::plane_overlay::{self, DiskLayer};
 use super::pseudo::{self, Domain};
 use super::trimesh::{self, TriMesh};
-use super::{glb, input_name, interpolate, output, report, Correspondence, MorphParams, Registration};
+use super::{input_name, output, report, Correspondence, MorphParams, Registration};
 
 /// Runs the planar pipeline when input 0 is a disk; `None` sends the job to the spherical path.
 pub fn dispatch(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Option<Output>> {
@@ -357,33 +357,7 @@ pub(super) fn finish(
     let back = f.frames_out[0].inverse();
     let shapes_out: Vec<Vec<Point3>> =
         layer.shapes.iter().map(|s| s.iter().map(|&p| back.apply(p)).collect()).collect();
-    let meshes = stages.run(progress, "interpolate", || {
-        let mk = |pos: Vec<Point3>| Mesh::from_triangles(pos, &layer.tris);
-        Ok(if let Some(w) = &params.blend_weights {
-            vec![mk(interpolate::blend(&shapes_out, w))]
-        } else if params.output_frames {
-            (0..params.frames)
-                .map(|j| {
-                    let (leg, t) = interpolate::frame_position(j, params.frames, k_in);
-                    mk(interpolate::frame(&shapes_out, leg, t))
-                })
-                .collect()
-        } else {
-            shapes_out.iter().map(|s| mk(s.clone())).collect()
-        })
-    })?;
-    let glb_bytes = stages.run(progress, "glb", || {
-        let keys = interpolate::keyframes(params.frames, k_in, params.duration_seconds);
-        glb::write(&layer.tris, &shapes_out, &keys)
-    })?;
-    let mut artifacts =
-        vec![Artifact { name: "morph.glb".into(), media_type: "model/gltf-binary".into(), bytes: glb_bytes }];
-    if let Some(fmt) = params.frames_zip {
-        let z = stages.run(progress, "frames_zip", || {
-            output::frames_zip(&layer.tris, &shapes_out, params.frames, fmt, progress)
-        })?;
-        artifacts.insert(0, z);
-    }
+    let (meshes, artifacts) = output::write_outputs(&mut stages, progress, params, &layer.tris, &shapes_out)?;
     let hausdorff = stages.run(progress, "report", || {
         Ok((0..k_in)
             .map(|k| {
