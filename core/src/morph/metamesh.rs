@@ -71,7 +71,7 @@ enum Label {
 /// on; exactly antisymmetric in (u, v), and a point exactly on the circle counts as left of the
 /// canonical direction, so every point is on exactly one side.
 #[inline]
-fn left(s: &[Point3], u: u32, v: u32, p: Point3) -> bool {
+pub(super) fn left(s: &[Point3], u: u32, v: u32, p: Point3) -> bool {
     if u < v {
         orient(s[u as usize], s[v as usize], p) >= 0.0
     } else {
@@ -80,7 +80,7 @@ fn left(s: &[Point3], u: u32, v: u32, p: Point3) -> bool {
 }
 
 #[inline]
-fn inside(s: &[Point3], t: [u32; 3], p: Point3) -> bool {
+pub(super) fn inside(s: &[Point3], t: [u32; 3], p: Point3) -> bool {
     left(s, t[0], t[1], p) && left(s, t[1], t[2], p) && left(s, t[2], t[0], p)
 }
 

@@ -330,41 +330,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     }
 
     // 2. Normalise.
-    let (normalised, frames_out, icp_reports) = stages.run(progress, "normalise", || {
-        let mut frames: Vec<Similarity> = Vec::new();
-        for (k, m) in meshes.iter().enumerate() {
-            let f = match params.registration {
-                Registration::None => {
-                    if k == 0 {
-                        register::pca_frame(&m.pos, &m.tris).to_normalised
-                    } else {
-                        frames[0]
-                    }
-                }
-                _ => register::pca_frame(&m.pos, &m.tris).to_normalised,
-            };
-            frames.push(f);
-        }
-        let mut norm: Vec<TriMesh> = meshes
-            .iter()
-            .zip(&frames)
-            .map(|(m, f)| TriMesh { pos: m.pos.iter().map(|&p| f.apply(p)).collect(), tris: m.tris.clone() })
-            .collect();
-        let mut icp = Vec::new();
-        if params.registration == Registration::PcaIcp {
-            let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
-            for k in 1..k_in {
-                progress.fraction(k as f64 / k_in as f64)?;
-                let r = register::icp(&norm[k].pos, &target, 50);
-                for p in &mut norm[k].pos {
-                    *p = r.transform.apply(*p);
-                }
-                frames[k] = r.transform.then_after(&frames[k]);
-                icp.push(r);
-            }
-        }
-        Ok((norm, frames, icp))
-    })?;
+    let (normalised, frames_out, icp_reports) =
+        stages.run(progress, "normalise", || normalise(&meshes, params.registration, progress))?;
 
     // 3. Parameterise every input (in parallel: they are independent).
     let settings = param::ParamSettings {
@@ -517,4 +484,43 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "stages": stages.to_json(),
     });
     Ok(Output { meshes: out_meshes, artifacts, report })
+}
+
+/// Step 2 of both domains: every input in its PCA frame (with `Registration::None`, every input in
+/// input 0's frame, so their relative placement is kept), then with `PcaIcp` rigid ICP of inputs
+/// 1.. onto input 0. Returns the normalised meshes, each input's frame (input → normalised) and the
+/// ICP results.
+pub(crate) fn normalise(
+    meshes: &[TriMesh],
+    registration: Registration,
+    progress: &Progress,
+) -> Result<(Vec<TriMesh>, Vec<Similarity>, Vec<register::IcpResult>)> {
+    let mut frames: Vec<Similarity> = Vec::new();
+    for m in meshes {
+        let f = if registration == Registration::None && !frames.is_empty() {
+            frames[0]
+        } else {
+            register::pca_frame(&m.pos, &m.tris).to_normalised
+        };
+        frames.push(f);
+    }
+    let mut norm: Vec<TriMesh> = meshes
+        .iter()
+        .zip(&frames)
+        .map(|(m, f)| TriMesh { pos: m.pos.iter().map(|&p| f.apply(p)).collect(), tris: m.tris.clone() })
+        .collect();
+    let mut icp = Vec::new();
+    if registration == Registration::PcaIcp {
+        let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
+        for k in 1..norm.len() {
+            progress.fraction(k as f64 / norm.len() as f64)?;
+            let r = register::icp(&norm[k].pos, &target, 50);
+            for p in &mut norm[k].pos {
+                *p = r.transform.apply(*p);
+            }
+            frames[k] = r.transform.then_after(&frames[k]);
+            icp.push(r);
+        }
+    }
+    Ok((norm, frames, icp))
 }

@@ -18,14 +18,14 @@ use crate::error::{Error, Result};
 use crate::geometry::{add, triangle_cross};
 use crate::job::{Artifact, Output, Progress, Stages};
 use crate::mesh::{Mesh, Point3};
-use crate::register::{self, Similarity};
+use crate::register::Similarity;
 
 use super::metamesh::{self, Layer};
 use super::planar::{self, DiskMap};
 use super::plane_overlay::{self, DiskLayer};
 use super::pseudo::{self, Domain};
 use super::trimesh::{self, TriMesh};
-use super::{input_name, output, report, Correspondence, MorphParams, Registration};
+use super::{input_name, output, report, Correspondence, MorphParams};
 
 /// Runs the planar pipeline when input 0 is a disk; `None` sends the job to the spherical path.
 pub fn dispatch(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Option<Output>> {
@@ -90,33 +90,7 @@ pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result
 
     // 2. Normalise (as the spherical path), then orient each disk's normal to +z.
     let (normalised, frames_out, icp_reports, flipped) = stages.run(progress, "normalise", || {
-        let mut frames: Vec<Similarity> = Vec::new();
-        for m in &meshes {
-            let f = if params.registration == Registration::None && !frames.is_empty() {
-                frames[0]
-            } else {
-                register::pca_frame(&m.pos, &m.tris).to_normalised
-            };
-            frames.push(f);
-        }
-        let mut norm: Vec<TriMesh> = meshes
-            .iter()
-            .zip(&frames)
-            .map(|(m, f)| TriMesh { pos: m.pos.iter().map(|&p| f.apply(p)).collect(), tris: m.tris.clone() })
-            .collect();
-        let mut icp = Vec::new();
-        if params.registration == Registration::PcaIcp {
-            let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
-            for k in 1..k_in {
-                progress.fraction(k as f64 / k_in as f64)?;
-                let r = register::icp(&norm[k].pos, &target, 50);
-                for p in &mut norm[k].pos {
-                    *p = r.transform.apply(*p);
-                }
-                frames[k] = r.transform.then_after(&frames[k]);
-                icp.push(r);
-            }
-        }
+        let (mut norm, frames, icp) = super::normalise(&meshes, params.registration, progress)?;
         let flipped: Vec<bool> = norm.iter_mut().map(orient_up).collect();
         Ok((norm, frames, icp, flipped))
     })?;

@@ -21,7 +21,8 @@ use crate::mesh::Point3;
 
 use super::correspond::{bary_on_chord, interpolate, Locator};
 use super::metamesh::{Layer, OverlayReport};
-use super::param::orient;
+// Side/inside tests on lifted plane points are the spherical overlay's (one canonical-direction rule).
+use super::metamesh::{inside, left};
 use super::planar::lift;
 
 /// A disk triangulation with shapes, and each vertex's common-boundary index (`u32::MAX` inside).
@@ -37,20 +38,6 @@ enum Label {
     B(u32),
     S(u32),
     X(u32, u32, u32, u32),
-}
-
-#[inline]
-fn left(s: &[Point3], u: u32, v: u32, p: Point3) -> bool {
-    if u < v {
-        orient(s[u as usize], s[v as usize], p) >= 0.0
-    } else {
-        !(orient(s[v as usize], s[u as usize], p) >= 0.0)
-    }
-}
-
-#[inline]
-fn inside(s: &[Point3], t: [u32; 3], p: Point3) -> bool {
-    left(s, t[0], t[1], p) && left(s, t[1], t[2], p) && left(s, t[2], t[0], p)
 }
 
 fn canon(u: u32, v: u32) -> (u32, u32) {
