@@ -27,6 +27,7 @@ pub mod plane_overlay;
 pub mod pseudo;
 pub mod report;
 pub mod simplify;
+pub mod sphere_fallback;
 pub mod trimesh;
 
 use serde::{Deserialize, Serialize};
@@ -125,6 +126,9 @@ pub struct MorphParams {
     pub planar_method: planar::PlanarMethod,
     /// `correspondence: pseudo`: most 1-to-4 subdivision levels per target triangle.
     pub pseudo_max_depth: u32,
+    /// Spherical parameterisation: `auto` (progressive, with the guaranteed Tutte fallback when
+    /// it fails or leaves a flipped triangle), `progressive` or `tutte` (the fallback alone).
+    pub sphere_method: param::SphereMethod,
 }
 
 impl Default for MorphParams {
@@ -149,6 +153,7 @@ impl Default for MorphParams {
             frames_zip: None,
             planar_method: planar::PlanarMethod::Elrp,
             pseudo_max_depth: 8,
+            sphere_method: param::SphereMethod::Auto,
         }
     }
 }
@@ -347,6 +352,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         },
         relax_sweeps: params.relax_sweeps,
         final_relax_sweeps: params.final_relax_sweeps,
+        sphere_method: params.sphere_method,
+        ..Default::default()
     };
     let maps_sph: Vec<param::SphereMap> = stages.run(progress, "parameterise", || {
         use rayon::prelude::*;
@@ -458,6 +465,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "angle_distortion": maps_sph.iter().map(|m| m.report.angle_distortion).collect::<Vec<_>>(),
         "area_distortion": maps_sph.iter().map(|m| m.report.area_distortion).collect::<Vec<_>>(),
         "foldovers": maps_sph.iter().map(|m| m.report.foldovers).collect::<Vec<_>>(),
+        "param_method": maps_sph.iter().map(|m| m.report.param_method.as_str()).collect::<Vec<_>>(),
+        "param_fallback_reason": maps_sph.iter().map(|m| m.report.param_fallback_reason.clone()).collect::<Vec<_>>(),
         "metamesh_vertices": layer.sphere.len(),
         "metamesh_faces": layer.tris.len(),
         "correspondence": match (params.correspondence, &fallback) {
