@@ -409,3 +409,37 @@ fn auto_rule_on_analytic_and_shared_meshes() {
         assert_eq!(c, want, "{name}: {why}");
     }
 }
+
+/// Feature indices refer to the input files: through the repair (which drops the vertices only the
+/// hole's faces used, renumbering the rest) a pair still means the same two points, and they meet.
+#[test]
+fn feature_indices_survive_the_repair_renumbering() {
+    let (damaged, _) = holed_hemisphere();
+    let used: std::collections::HashSet<u32> = tris_of(&damaged).into_iter().flatten().collect();
+    let first_dropped =
+        (0..damaged.positions.len() as u32).find(|v| !used.contains(v)).expect("a dropped vertex");
+    // A source vertex numbered after the dropped one (so its index shifts), away from the rim.
+    let va = (first_dropped + 1..damaged.positions.len() as u32)
+        .find(|v| used.contains(v) && damaged.positions[*v as usize][2] > 0.3)
+        .expect("a later vertex");
+    let target = paraboloid(10);
+    let vb = (0..target.positions.len() as u32)
+        .min_by(|&i, &j| {
+            let d = |k: u32| target.positions[k as usize][0].hypot(target.positions[k as usize][1] + 0.3);
+            d(i).total_cmp(&d(j))
+        })
+        .unwrap();
+    let out = morph(
+        vec![damaged.clone(), target.clone()],
+        json!({"repair": true, "domain": "disk", "registration": "none", "frames": 3, "features": [[va, vb]]}),
+    );
+    assert_eq!(out.report["features"]["foldovers"], 0, "{}", out.report["features"]);
+    let (m0, m1) = (&out.meshes[0].positions, &out.meshes[1].positions);
+    // The metamesh vertex at the source vertex (input 0's coordinates, through the normalising
+    // similarity and back: equal up to round-off).
+    let pa = damaged.positions[va as usize];
+    let k = (0..m0.len()).min_by(|&i, &j| norm(sub(m0[i], pa)).total_cmp(&norm(sub(m0[j], pa)))).unwrap();
+    assert!(norm(sub(m0[k], pa)) < 1e-9, "source vertex not in the metamesh");
+    let gap = norm(sub(m1[k], target.positions[vb as usize])) / diag(&target.positions);
+    assert!(gap < 1e-3, "feature ({va}, {vb}) ends {gap} apart; {}", out.report["features"]);
+}
