@@ -237,6 +237,7 @@ fn disk_with_an_extra_hole_is_morphed_after_repair_with_domain_disk_and_auto() {
         assert_eq!(s0["outer_boundary_edges"], SEG, "{s0}");
         let outer = &rep[0]["holes"]["outer_boundary"];
         assert!((outer["length"].as_f64().unwrap() - rim_length()).abs() < 1e-9, "{outer}");
+        assert_eq!(outer["also_largest_vector_area"], true, "{outer}");
         assert_eq!(rep[0]["holes"]["loops"].as_array().unwrap().len(), 2);
         assert_eq!(rep[0]["holes"]["fill"]["skipped_by_reason"]["kept open"], 1);
         // The vertices in and out add up: the vertices only the removed faces used (counted here)
@@ -442,4 +443,37 @@ fn feature_indices_survive_the_repair_renumbering() {
     assert!(norm(sub(m0[k], pa)) < 1e-9, "source vertex not in the metamesh");
     let gap = norm(sub(m1[k], target.positions[vb as usize])) / diag(&target.positions);
     assert!(gap < 1e-3, "feature ({va}, {vb}) ends {gap} apart; {}", out.report["features"]);
+}
+
+/// A hole touching the rim at one vertex (a pinch: the two loops share it): the one-triangle hole
+/// is filled (with that very triangle, the only way to close three edges), the rim kept, and the
+/// first frame is the undamaged hemisphere.
+#[test]
+fn hole_touching_the_rim_at_a_vertex_is_filled() {
+    let h = hemisphere();
+    let mut t = tris_of(&h);
+    // The last band's triangle [a, d, b] of segment 5: d on the rim, a and b on the ring above.
+    let idx = SEG + (RINGS - 2) * 2 * SEG + 2 * 5 + 1;
+    let on_rim = t[idx].iter().filter(|&&v| h.positions[v as usize][2].abs() < 1e-12).count();
+    assert_eq!(on_rim, 1);
+    t.remove(idx);
+    let m = Mesh::from_triangles(h.positions.clone(), &t);
+    for dom in ["disk", "auto"] {
+        let out = morph(vec![m.clone(), paraboloid(8)], json!({"repair": true, "domain": dom, "frames": 3}));
+        let r = &out.report;
+        assert_eq!(r["domain"], "planar", "{}", r["domain_reason"]);
+        let s = &r["repair"][0]["summary"];
+        assert_eq!((s["holes_filled"].as_u64(), s["faces_added"].as_u64()), (Some(1), Some(1)), "{s}");
+        assert_eq!(s["outer_boundary_edges"], SEG, "{s}");
+        let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
+        let d = h
+            .positions
+            .iter()
+            .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+            .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
+            .fold(0.0, f64::max)
+            / diag(&h.positions);
+        assert!(d < 1e-9, "first frame vs hemisphere {d}");
+        assert!((area(&out.meshes[0]) / area(&h) - 1.0).abs() < 1e-12);
+    }
 }
