@@ -477,3 +477,59 @@ fn hole_touching_the_rim_at_a_vertex_is_filled() {
         assert!((area(&out.meshes[0]) / area(&h) - 1.0).abs() < 1e-12);
     }
 }
+
+/// The hemisphere cut open along the seam between segments SEG−1 and 0 (the faces of that strip
+/// use duplicates of the segment-0 vertices, as an exporter splitting UV seams writes it): the
+/// repair's weld merges one duplicate per ring, counted in the summary, and the first frame is the
+/// closed-up hemisphere.
+#[test]
+fn welded_seam_is_counted_and_the_surface_restored() {
+    let h = hemisphere();
+    let mut pos = h.positions.clone();
+    let id = |i: usize, j: usize| (1 + (i - 1) * SEG + j) as u32;
+    let first: Vec<u32> = (1..=RINGS).map(|i| id(i, 0)).collect();
+    let last: Vec<u32> = (1..=RINGS).map(|i| id(i, SEG - 1)).collect();
+    let mut dup = std::collections::HashMap::new();
+    let tris: Vec<[u32; 3]> = tris_of(&h)
+        .into_iter()
+        .map(|t| {
+            if !t.iter().any(|v| last.contains(v)) {
+                return t;
+            }
+            t.map(|v| {
+                if first.contains(&v) {
+                    *dup.entry(v).or_insert_with(|| {
+                        pos.push(h.positions[v as usize]);
+                        (pos.len() - 1) as u32
+                    })
+                } else {
+                    v
+                }
+            })
+        })
+        .collect();
+    assert_eq!(dup.len(), RINGS);
+    let cut = Mesh::from_triangles(pos, &tris);
+    let out = morph(vec![cut.clone(), paraboloid(8)], json!({"repair": true, "frames": 3}));
+    let r = &out.report;
+    assert_eq!(r["domain"], "planar", "{}", r["domain_reason"]);
+    let s = &r["repair"][0]["summary"];
+    assert_eq!(s["vertices_in"], h.positions.len() + RINGS, "{s}");
+    assert_eq!(s["vertices_merged"], RINGS, "{s}");
+    assert_eq!(s["vertices_removed_unreferenced"], RINGS, "{s}");
+    assert_eq!(s["vertices_out"], h.positions.len(), "{s}");
+    assert_eq!(s["holes_filled"], 0, "{s}");
+    let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
+    let d = h
+        .positions
+        .iter()
+        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
+        .fold(0.0, f64::max)
+        / diag(&h.positions);
+    assert!(d < 1e-9, "first frame vs hemisphere {d}");
+    // The rim is the hemisphere's again: SEG edges on the equator.
+    assert!(boundary_edges(&out.meshes[0])
+        .iter()
+        .all(|&(a, b)| { [a, b].iter().all(|&v| out.meshes[0].positions[v as usize][2].abs() < 1e-9) }));
+}
