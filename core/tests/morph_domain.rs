@@ -533,3 +533,34 @@ fn welded_seam_is_counted_and_the_surface_restored() {
         .iter()
         .all(|&(a, b)| { [a, b].iter().all(|&v| out.meshes[0].positions[v as usize][2].abs() < 1e-9) }));
 }
+
+/// A closed surface with one small hole is topologically a disk: without `repair` it takes the
+/// planar domain as it is; with `repair: true` the auto rule sees no rim (the hole spans a few % of
+/// the diagonal) and closes it for the spherical domain.
+#[test]
+fn sphere_with_one_small_hole_is_a_disk_as_is_and_a_sphere_after_repair() {
+    let s = shapes::icosphere(2, 1.0);
+    let mut t = tris_of(&s);
+    t.remove(7);
+    let holed = Mesh::from_triangles(s.positions.clone(), &t);
+    let target = shapes::icosphere(1, 1.0);
+    let out = morph(vec![holed.clone(), paraboloid(6)], json!({"frames": 2}));
+    assert_eq!(out.report["domain"], "planar", "{}", out.report["domain_reason"]);
+    let out = morph(vec![holed, target], json!({"frames": 2, "repair": true}));
+    let r = &out.report;
+    assert_eq!(r["domain"], "spherical", "{}", r["domain_reason"]);
+    assert!(r["domain_reason"].as_str().unwrap().contains("no loop is a rim"), "{}", r["domain_reason"]);
+    assert_eq!(r["repair"][0]["summary"]["holes_filled"], 1);
+    assert_eq!(r["repair"][0]["summary"]["faces_added"], 1);
+    assert_eq!(r["foldovers"], json!([0, 0]));
+    // The one-triangle hole is closed by that triangle: the first frame is the icosphere.
+    let (st, ft) = (tris_of(&s), tris_of(&out.meshes[0]));
+    let d = s
+        .positions
+        .iter()
+        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &s.positions, &st)))
+        .fold(0.0, f64::max)
+        / diag(&s.positions);
+    assert!(d < 1e-9, "first frame vs icosphere {d}");
+}
