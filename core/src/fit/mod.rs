@@ -15,6 +15,8 @@
 //! The output mesh has one face group per region and carries the curves as vertex chains.
 
 pub mod align;
+pub mod cleanup;
+pub mod compact;
 pub mod correspond;
 pub mod curves;
 pub mod flips;
@@ -28,6 +30,7 @@ pub mod retriangulate;
 pub mod smooth;
 pub mod testdata;
 pub mod trimesh;
+pub mod uvs;
 
 use std::collections::HashSet;
 
@@ -110,6 +113,10 @@ pub struct FitParams {
     /// A segment crossing an edge within this fraction of its length from a vertex snaps the
     /// vertex onto the segment (0 disables; at most 0.5).
     pub snap_fraction: f64,
+    /// Run the sliver clean-up after re-triangulation (edge flips, then collapses of free vertices).
+    pub cleanup: bool,
+    /// Faces whose smallest angle is below this (degrees) are treated by the clean-up.
+    pub cleanup_min_angle_deg: f64,
     /// Run the smoothing stage.
     pub smooth: bool,
     /// Iterations of the modified mean-curvature flow.
@@ -134,6 +141,8 @@ impl Default for FitParams {
             max_curve_distance: 0.25,
             max_flip_iterations: 4,
             snap_fraction: 0.3,
+            cleanup: true,
+            cleanup_min_angle_deg: 15.0,
             smooth: true,
             mcf_iterations: 10,
             mcf_step: 0.5,
@@ -157,6 +166,9 @@ impl FitParams {
         }
         if !(self.mcf_step.is_finite() && self.mcf_step > 0.0 && self.mcf_step <= 1.0) {
             return bad("mcf_step", "must be in (0, 1]");
+        }
+        if !(self.cleanup_min_angle_deg.is_finite() && (0.0..=50.0).contains(&self.cleanup_min_angle_deg)) {
+            return bad("cleanup_min_angle_deg", "must be in [0, 50]");
         }
         if self.max_flip_iterations > 20 {
             return bad("max_flip_iterations", "must be ≤ 20");
@@ -251,27 +263,91 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
-    let out_tris = mesh.live_triangles();
     let mut curve_edges = HashSet::<(u32, u32), std::hash::BuildHasherDefault<trimesh::IntHasher>>::default();
     for c in &realised.chains {
         for p in c.windows(2) {
             curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
         }
     }
-    let (region, region_count) =
-        stages.run(progress, "partition", || Ok(partition::regions(&out_tris, &curve_edges)))?;
-    let angles_before = report::angle_stats(&mesh.pos, &out_tris);
-    let mut out_pos = mesh.pos.clone();
+    let retri_tris = mesh.live_triangles();
+    let angles_retri = report::angle_stats(&mesh.pos, &retri_tris);
+    let (region0, region_count) =
+        stages.run(progress, "partition", || Ok(partition::regions(&retri_tris, &curve_edges)))?;
+    // Label of every face id: region × template group, kept by the clean-up.
+    let group0 = if keep_groups {
+        groups::after_retriangulation(&fine_tris, &fine_groups, &retri_tris, mesh.pos.len())
+    } else {
+        vec![0; retri_tris.len()]
+    };
+    let mut labels = vec![u64::MAX; mesh.tris.len()];
+    for ((f, &r), &g) in mesh.alive_faces().collect::<Vec<_>>().into_iter().zip(&region0).zip(&group0) {
+        labels[f as usize] = ((r as u64) << 32) | g as u64;
+    }
+    drop(retri_tris);
+    let fixed: Vec<bool> = (0..mesh.pos.len() as u32)
+        .map(|v| realised.on_curve[v as usize] || mesh.is_boundary_vertex(v))
+        .collect();
+    let cleaned = stages.run(progress, "cleanup", || {
+        if !params.cleanup {
+            return Ok(cleanup::CleanupStats::default());
+        }
+        let mut curve_point = vec![false; mesh.pos.len()];
+        for &v in &fine.vertex_of_point {
+            curve_point[v as usize] = true;
+        }
+        let boundary: Vec<bool> = (0..mesh.pos.len() as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+        let mut c = cleanup::Constraints {
+            fixed: &fixed,
+            locked: curve_edges.clone(),
+            chain: cleanup::Constraints::chain_vertices(&realised.chains, &curve_point, &boundary),
+            reference_normals: &reference_normals,
+        };
+        let s = cleanup::CleanupSettings { min_angle_deg: params.cleanup_min_angle_deg, max_passes: 8 };
+        cleanup::clean(&mut mesh, &mut labels, &mut c, &s, progress)
+    })?;
+    // Vertices removed by collapses leave the output; every per-vertex array is renumbered.
+    let keep = compact::Renumber::new(mesh.pos.len(), &cleaned.removed_vertices);
+    let out_tris: Vec<[u32; 3]> = mesh.alive_faces().map(|f| keep.tri(mesh.tris[f as usize])).collect();
+    let region: Vec<u32> = mesh.alive_faces().map(|f| (labels[f as usize] >> 32) as u32).collect();
+    // Template groups of the faces the clean-up made: the rule used for re-triangulated faces
+    // (the clean-up never edits across a group border, but a face re-triangulation made across
+    // one carries a majority label that is not the geometric truth for its pieces).
+    let tg = if keep_groups && cleaned.flips + cleaned.collapses > 0 {
+        groups::after_retriangulation(&fine_tris, &fine_groups, &mesh.live_triangles(), mesh.pos.len())
+    } else {
+        mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
+    };
+    let fixed = keep.vec(&fixed);
+    let mut realised = realised;
+    if !cleaned.removed_vertices.is_empty() {
+        // Chain vertices the clean-up removed leave their chains (their neighbours are joined).
+        let mut gone = vec![false; mesh.pos.len()];
+        for &v in &cleaned.removed_vertices {
+            gone[v as usize] = true;
+        }
+        for c in realised.chains.iter_mut() {
+            c.retain(|&v| !gone[v as usize]);
+        }
+    }
+    for c in realised.chains.iter_mut() {
+        keep.apply(c);
+    }
+    let mut vertex_of_point = fine.vertex_of_point.clone();
+    keep.apply(&mut vertex_of_point);
+    let reference_normals = keep.vec(&reference_normals);
+    let reference_pos = keep.vec(&fine.positions);
+    let mut out_pos = keep.vec(&mesh.pos);
+    let angles_before = report::angle_stats(&out_pos, &out_tris);
+    let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
-        let fixed: Vec<bool> = (0..out_pos.len() as u32)
-            .map(|v| realised.on_curve[v as usize] || mesh.is_boundary_vertex(v))
-            .collect();
         let settings = smooth::SmoothSettings {
             mcf_iterations: params.mcf_iterations,
             mcf_step: params.mcf_step,
             laplacian_iterations: params.laplacian_iterations,
+            // Smoothing does not make a face the clean-up accepts into one it would treat.
+            min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
-        stages.run(progress, "smooth", || {
+        smoothing = stages.run(progress, "smooth", || {
             smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
         })?;
     }
@@ -282,7 +358,6 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut faces = Faces::with_capacity(out_tris.len(), out_tris.len() * 3);
     let mut group_names: Vec<String> = (0..region_count).map(|i| format!("region_{i}")).collect();
     if keep_groups {
-        let tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
         let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
         group_names.clear();
         for ((t, &r), &g) in out_tris.iter().zip(&region).zip(&tg) {
@@ -298,7 +373,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         }
     }
     let mut out = Mesh::new(out_pos, faces);
-    out.uvs = template.uvs.as_ref().map(|uv| interpolate_uvs(uv, &parents));
+    out.uvs = template.uvs.as_ref().map(|uv| {
+        let mut uvs = interpolate_uvs(uv, &parents);
+        uvs::apply(&mut uvs, &realised.uv_moves);
+        keep.vec(&uvs)
+    });
     out.groups = group_names;
     out.curves = report::polyline_chains(&net, &realised.chains);
 
@@ -306,10 +385,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         Ok(report::Quality::measure(
             &out,
             &net,
-            &fine.vertex_of_point,
+            &vertex_of_point,
             &realised,
             &out_tris,
-            &fine.positions,
+            &reference_pos,
             &reference_normals,
         ))
     })?;
@@ -336,6 +415,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "segments_as_edges": quality.segments_as_edges,
         "flipped_faces": quality.flipped_faces,
         "flipped_faces_after_fine": fine.report.flipped_faces,
+        "cleanup": cleaned,
+        "moved_vertices": realised.uv_moves.iter().map(|m| m.vertex).collect::<Vec<_>>(),
+        "smoothing": smoothing,
+        "min_angle_deg_after_retriangulation": angles_retri.min_deg,
+        "mean_min_angle_deg_after_retriangulation": angles_retri.mean_min_deg,
+        "faces_below_10deg_after_retriangulation": angles_retri.below_10,
         "min_angle_deg_before_smoothing": angles_before.min_deg,
         "min_angle_deg_after_smoothing": angles_after.min_deg,
         "mean_min_angle_deg_before_smoothing": angles_before.mean_min_deg,
