@@ -60,7 +60,13 @@ fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
 }
 
 fn settings() -> ParamSettings {
-    ParamSettings { working_vertices: 300, max_flatten_rounds: 30, relax_sweeps: 3, final_relax_sweeps: 10 }
+    ParamSettings {
+        working_vertices: 300,
+        max_flatten_rounds: 30,
+        relax_sweeps: 3,
+        final_relax_sweeps: 10,
+        ..Default::default()
+    }
 }
 
 #[test]

@@ -154,7 +154,15 @@ pub fn insert_curve_points(
                     );
                     x = add(scale(x, 0.8), scale(centroid, 0.2));
                     if nudges > 8 {
-                        return Err(Error::Internal(format!("curve point {p}: no free place near its foot")));
+                        // Only a degenerate neighbourhood (zero-area faces) leaves no room: the
+                        // centroid pull above always frees an inner point of a proper face.
+                        return Err(Error::InvalidMesh {
+                            location: crate::error::Location::Face(tf_template as usize),
+                            message: format!(
+                                "the template is degenerate here (zero-area faces): curve point {p} has no \
+                                 free place to be inserted near its closest point; repair or remesh the template"
+                            ),
+                        });
                     }
                     continue;
                 }

@@ -1,6 +1,9 @@
 //! The morph job (seeds 002/003): morph sequences between closed genus-0 meshes of different
 //! connectivity.
 //!
+//! The domain (spherical, or planar for disks: [`planar_job`]) and, with `repair`, the preparation
+//! of damaged inputs for it are decided first by [`domain`] (stage `repair`).
+//!
 //! Pipeline, one timed stage each: `validate` (closed, connected, manifold, genus 0; outward
 //! orientation) → `normalise` (PCA frame with a deterministic sign rule, unit sphere; optional
 //! point-to-plane ICP onto input 0) → `parameterise` (per input, [`param`]: recorded QEM
@@ -16,6 +19,7 @@
 
 pub mod align;
 pub mod correspond;
+pub mod domain;
 pub mod glb;
 pub mod interpolate;
 pub mod metamesh;
@@ -27,6 +31,7 @@ pub mod plane_overlay;
 pub mod pseudo;
 pub mod report;
 pub mod simplify;
+pub mod sphere_fallback;
 pub mod trimesh;
 
 use serde::{Deserialize, Serialize};
@@ -94,7 +99,11 @@ pub struct MorphParams {
     /// they travel onto each other during the morph.
     pub features: Vec<Vec<u32>>,
     pub registration: Registration,
-    /// Run the foundation's repair on each input first (holes, non-manifold parts, small pieces).
+    /// `auto` (input 0 decides; with `repair` by the rim rule in docs/api.md), `sphere` or `disk`.
+    /// The report says which was used and why (`domain`, `domain_reason`).
+    pub domain: domain::MorphDomain,
+    /// Run the foundation's repair on each input first (non-manifold parts, small pieces, holes:
+    /// all holes for the spherical domain, all but the outer boundary for the planar one).
     pub repair: bool,
     pub param_method: ParamMethod,
     /// Vertex count of the simplified working mesh that is embedded directly (seed 002 used 500–1,200).
@@ -125,6 +134,9 @@ pub struct MorphParams {
     pub planar_method: planar::PlanarMethod,
     /// `correspondence: pseudo`: most 1-to-4 subdivision levels per target triangle.
     pub pseudo_max_depth: u32,
+    /// Spherical parameterisation: `auto` (progressive, with the guaranteed Tutte fallback when
+    /// it fails or leaves a flipped triangle), `progressive` or `tutte` (the fallback alone).
+    pub sphere_method: param::SphereMethod,
 }
 
 impl Default for MorphParams {
@@ -134,6 +146,7 @@ impl Default for MorphParams {
             duration_seconds: 2.0,
             features: Vec::new(),
             registration: Registration::Pca,
+            domain: domain::MorphDomain::Auto,
             repair: false,
             param_method: ParamMethod::CurvatureFlattening,
             working_vertices: 1000,
@@ -149,6 +162,7 @@ impl Default for MorphParams {
             frames_zip: None,
             planar_method: planar::PlanarMethod::Elrp,
             pseudo_max_depth: 8,
+            sphere_method: param::SphereMethod::Auto,
         }
     }
 }
@@ -207,60 +221,17 @@ fn input_name(k: usize) -> String {
 /// Inputs: 2..16 meshes (source, target, more for a multi-morph).
 pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Result<Output> {
     params.check(inputs.len())?;
-    // Disk-like inputs take the planar domain.
-    if let Some(out) = planar_job::dispatch(&inputs, params, progress)? {
-        return Ok(out);
-    }
     let k_in = inputs.len();
     let mut stages = Stages::new();
 
-    // 0. Optional repair (seed 003 §4.2: non-manifold parts, isolated pieces, holes), keeping
-    //    track of where each input vertex went so feature indices still mean the same vertex.
-    let mut repair_reports: Vec<serde_json::Value> = Vec::new();
-    let mut repair_maps: Vec<Option<Vec<u32>>> = vec![None; k_in];
-    let inputs: Vec<Mesh> = if params.repair {
-        stages.run(progress, "repair", || {
-            let rp = crate::repair::RepairParams {
-                keep_largest: true,
-                report_vertex_map: true,
-                ..Default::default()
-            };
-            let mut out = Vec::with_capacity(k_in);
-            for (k, m) in inputs.into_iter().enumerate() {
-                if m.positions.len() > params.max_vertices {
-                    return Err(Error::TooLarge {
-                        what: format!("{} vertices", input_name(k)),
-                        limit: params.max_vertices as u64,
-                        actual: m.positions.len() as u64,
-                    });
-                }
-                let r = crate::repair::run(m, &rp, progress)?;
-                let map: Vec<u32> = r.report["vertex_map"]["map"]
-                    .as_array()
-                    .map(|a| {
-                        a.iter()
-                            .map(|x| x.as_i64().filter(|&v| v >= 0).map_or(u32::MAX, |v| v as u32))
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                repair_maps[k] = Some(map);
-                let mut rep = r.report;
-                if let Some(vm) = rep.get_mut("vertex_map").and_then(|v| v.as_object_mut()) {
-                    vm.remove("map");
-                }
-                repair_reports.push(rep);
-                out.push(
-                    r.meshes
-                        .into_iter()
-                        .next()
-                        .ok_or_else(|| Error::Internal("repair returned no mesh".into()))?,
-                );
-            }
-            Ok(out)
-        })?
-    } else {
-        inputs
-    };
+    // 0. The domain, and with `repair` each input prepared for it (seed 003 §4.2), keeping track
+    //    of where each input vertex went so feature indices still mean the same vertex.
+    let prep = domain::prepare(inputs, params, progress, &mut stages)?;
+    if prep.domain == domain::Chosen::Planar {
+        return planar_job::run(prep, params, progress, stages);
+    }
+    let domain::Prepared { meshes: inputs, vertex_maps: repair_maps, repair: repair_reports, reason, .. } =
+        prep;
 
     // 1. Validate.
     let (meshes, maps, conv_reports, topo) = stages.run(progress, "validate", || {
@@ -278,7 +249,10 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             }
             let (mut t, map, conv) = TriMesh::from_mesh(m);
             let info = trimesh::topology(&t);
-            trimesh::require_sphere_like(&info, &input_name(k))?;
+            trimesh::require_sphere_like(&info, &input_name(k)).map_err(|e| match e {
+                Error::Topology(m) => Error::Topology(format!("{m}; spherical domain: {reason}")),
+                e => e,
+            })?;
             let mut flipped = false;
             if signed_volume(&t.pos, &Faces::from_triangles(&t.tris)) < 0.0 {
                 for tr in &mut t.tris {
@@ -347,6 +321,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         },
         relax_sweeps: params.relax_sweeps,
         final_relax_sweeps: params.final_relax_sweeps,
+        sphere_method: params.sphere_method,
+        ..Default::default()
     };
     let maps_sph: Vec<param::SphereMap> = stages.run(progress, "parameterise", || {
         use rayon::prelude::*;
@@ -458,6 +434,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "angle_distortion": maps_sph.iter().map(|m| m.report.angle_distortion).collect::<Vec<_>>(),
         "area_distortion": maps_sph.iter().map(|m| m.report.area_distortion).collect::<Vec<_>>(),
         "foldovers": maps_sph.iter().map(|m| m.report.foldovers).collect::<Vec<_>>(),
+        "param_method": maps_sph.iter().map(|m| m.report.param_method.as_str()).collect::<Vec<_>>(),
+        "param_fallback_reason": maps_sph.iter().map(|m| m.report.param_fallback_reason.clone()).collect::<Vec<_>>(),
         "metamesh_vertices": layer.sphere.len(),
         "metamesh_faces": layer.tris.len(),
         "correspondence": match (params.correspondence, &fallback) {
@@ -470,6 +448,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "overlays": overlay_reps,
         "pseudo_metamesh": pseudo_reps,
         "domain": "spherical",
+        "domain_reason": reason,
         "frames_zip": params.frames_zip,
         "hausdorff_first_frame": hausdorff[0],
         "hausdorff_last_frame": hausdorff[k_in - 1],

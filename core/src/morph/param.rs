@@ -50,6 +50,24 @@ pub fn orient(a: Point3, b: Point3, c: Point3) -> f64 {
     dot(cross(a, b), c)
 }
 
+/// Which spherical parameterisation is used.
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, utoipa::ToSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum SphereMethod {
+    /// The progressive map (flattening + vertex splits); the Tutte fallback when it fails or
+    /// leaves a flipped triangle (the report says so and why).
+    #[default]
+    Auto,
+    /// Only the progressive map (fails with a numerical problem if it cannot embed).
+    Progressive,
+    /// Only the guaranteed fallback: Tutte embedding of the mesh minus one vertex, inverse
+    /// stereographic projection, Möbius normalisation, fold-free relaxation
+    /// ([`super::sphere_fallback`]).
+    Tutte,
+}
+
 /// Settings of the parameterisation (a subset of the job parameters).
 #[derive(Clone, Debug)]
 pub struct ParamSettings {
@@ -57,6 +75,27 @@ pub struct ParamSettings {
     pub max_flatten_rounds: usize,
     pub relax_sweeps: usize,
     pub final_relax_sweeps: usize,
+    pub sphere_method: SphereMethod,
+    /// Fold-free relaxation sweeps after the fallback's Tutte map.
+    pub fallback_relax_sweeps: usize,
+    /// Test hook: the progressive path reports a numerical failure without trying (to test the
+    /// fallback's wiring on inputs where the progressive path works).
+    #[doc(hidden)]
+    pub inject_progressive_failure: bool,
+}
+
+impl Default for ParamSettings {
+    fn default() -> Self {
+        ParamSettings {
+            working_vertices: 1000,
+            max_flatten_rounds: 30,
+            relax_sweeps: 3,
+            final_relax_sweeps: 10,
+            sphere_method: SphereMethod::Auto,
+            fallback_relax_sweeps: super::sphere_fallback::FallbackSettings::default().relax_sweeps,
+            inject_progressive_failure: false,
+        }
+    }
 }
 
 /// A spherical embedding of a mesh: one unit vector per vertex.
@@ -68,7 +107,15 @@ pub struct SphereMap {
 
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct ParamReport {
-    /// "curvature_flattening" or "tetrahedron" (the fallback when flattening did not reach a star shape).
+    /// "progressive" (flattening or tetrahedron, then vertex splits) or "fallback_tutte" (the
+    /// guaranteed construction of [`super::sphere_fallback`]).
+    pub param_method: String,
+    /// Why the Tutte fallback was used (the progressive path's failure, or that it was asked for).
+    pub param_fallback_reason: Option<String>,
+    /// What the Tutte fallback did, when it ran.
+    pub tutte: Option<super::sphere_fallback::FallbackReport>,
+    /// How the coarse map of the progressive path was made: "curvature_flattening" or
+    /// "tetrahedron" (when flattening did not reach a star shape); "tutte" for the fallback.
     pub method: String,
     pub working_vertices: usize,
     pub flatten_rounds: usize,
@@ -90,10 +137,72 @@ pub struct ParamReport {
     pub timings_ms: Vec<(String, f64)>,
 }
 
-/// Parameterises, retrying with other settings when a vertex split finds no valid position
+/// Parameterises by `s.sphere_method`: the progressive map, with the guaranteed Tutte fallback
+/// when it fails or leaves a flipped triangle (`auto`), or one of the two alone. Every result's
+/// `foldovers` is counted with the exact orientation test.
+pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
+    match s.sphere_method {
+        SphereMethod::Progressive => progressive(mesh, s, progress),
+        SphereMethod::Tutte => tutte_fallback(mesh, s, "sphere_method: tutte".into(), Vec::new(), progress),
+        SphereMethod::Auto => match progressive(mesh, s, progress) {
+            Ok(m) if m.report.foldovers == 0 => Ok(m),
+            Ok(m) => tutte_fallback(
+                mesh,
+                s,
+                format!("the progressive map left {} flipped triangles", m.report.foldovers),
+                m.report.retries,
+                progress,
+            ),
+            Err(Error::Numerical { message, .. }) => tutte_fallback(
+                mesh,
+                s,
+                format!("the progressive map failed: {message}"),
+                Vec::new(),
+                progress,
+            ),
+            Err(e) => Err(e),
+        },
+    }
+}
+
+/// The guaranteed map ([`super::sphere_fallback`]) with its report.
+fn tutte_fallback(
+    mesh: &TriMesh,
+    s: &ParamSettings,
+    reason: String,
+    retries: Vec<String>,
+    progress: &Progress,
+) -> Result<SphereMap> {
+    let clock = std::time::Instant::now();
+    let fs = super::sphere_fallback::FallbackSettings {
+        relax_sweeps: s.fallback_relax_sweeps,
+        ..Default::default()
+    };
+    let (sphere, fr) = super::sphere_fallback::parameterise(mesh, &fs, progress)?;
+    let (ad, sd) = distortion(&mesh.pos, &sphere, &mesh.tris);
+    let rep = ParamReport {
+        param_method: "fallback_tutte".into(),
+        param_fallback_reason: Some(reason),
+        tutte: Some(fr),
+        method: "tutte".into(),
+        working_vertices: mesh.pos.len(),
+        foldovers: count_foldovers(&sphere, &mesh.tris),
+        angle_distortion: ad,
+        area_distortion: sd,
+        retries,
+        timings_ms: vec![("tutte_fallback".into(), (clock.elapsed().as_secs_f64() * 1e6).round() / 1e3)],
+        ..Default::default()
+    };
+    Ok(SphereMap { sphere, report: rep })
+}
+
+/// The progressive map, retrying with other settings when a vertex split finds no valid position
 /// (thin spherical triangles can leave a numerically empty kernel): first as asked, then from a
 /// tetrahedron, then with half and double the working size. The report names the retries.
-pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
+fn progressive(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
+    if s.inject_progressive_failure {
+        return Err(Error::numerical("parameterise", "failure injected by the test hook"));
+    }
     let mut tries = vec![s.clone()];
     if s.max_flatten_rounds > 0 {
         tries.push(ParamSettings { working_vertices: 4, max_flatten_rounds: 0, ..s.clone() });
@@ -119,7 +228,7 @@ pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> R
 
 fn parameterise_once(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> Result<SphereMap> {
     let n = mesh.pos.len();
-    let mut rep = ParamReport::default();
+    let mut rep = ParamReport { param_method: "progressive".into(), ..Default::default() };
     let mut h = Hierarchy::new(&mesh.pos, &mesh.tris);
     let clock = std::time::Instant::now();
     let lap = |t: &mut std::time::Instant| -> f64 {
@@ -206,10 +315,9 @@ fn parameterise_once(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> 
     Ok(SphereMap { sphere, report: rep })
 }
 
+/// Faces whose chord triangle is not strictly positive, decided exactly.
 pub fn count_foldovers(sphere: &[Point3], tris: &[[u32; 3]]) -> usize {
-    tris.iter()
-        .filter(|t| !(orient(sphere[t[0] as usize], sphere[t[1] as usize], sphere[t[2] as usize]) > 0.0))
-        .count()
+    super::sphere_fallback::count_foldovers_exact(sphere, tris)
 }
 
 /// AD and SD of seed 002 eq. IV.64–IV.65 between the 3D mesh and its spherical chord triangles.
@@ -685,7 +793,7 @@ impl Stars {
 
 /// Gauss–Seidel sweeps moving each alive vertex towards its mean-value target, only by moves
 /// that keep every incident face positively oriented (halving the step up to 4 times).
-fn relax(
+pub(crate) fn relax(
     h: &Hierarchy,
     pos: &[Point3],
     sphere: &mut [Point3],

@@ -8,8 +8,8 @@
 //! `metamesh` (planar overlay, or the pseudo-metamesh / transfer) → `interpolate` → `glb`
 //! (→ `frames_zip`) → `report`.
 //!
-//! `repair` is not applied on this path: a disk that needs repair (holes, non-manifold parts) is
-//! not recognised as a disk, and the spherical path's repair closes holes.
+//! The domain is chosen, and with `repair` the inputs are prepared (every hole but the outer
+//! boundary filled), by [`super::domain`] before this runs.
 
 use rayon::prelude::*;
 use serde_json::json;
@@ -20,25 +20,13 @@ use crate::job::{Artifact, Output, Progress, Stages};
 use crate::mesh::{Mesh, Point3};
 use crate::register::Similarity;
 
+use super::domain::Prepared;
 use super::metamesh::{self, Layer};
 use super::planar::{self, DiskMap};
 use super::plane_overlay::{self, DiskLayer};
 use super::pseudo::{self, Domain};
 use super::trimesh::{self, TriMesh};
 use super::{input_name, output, report, Correspondence, MorphParams};
-
-/// Runs the planar pipeline when input 0 is a disk; `None` sends the job to the spherical path.
-pub fn dispatch(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Option<Output>> {
-    let Some(first) = inputs.first() else { return Ok(None) };
-    if first.positions.len() > params.max_vertices {
-        return Ok(None); // the spherical path reports the limit
-    }
-    let (t, _, _) = TriMesh::from_mesh(first);
-    if !planar::is_disk(&trimesh::topology(&t)) {
-        return Ok(None);
-    }
-    run(inputs, params, progress).map(Some)
-}
 
 fn orient_up(m: &mut TriMesh) -> bool {
     let n = m.tris.iter().fold([0.0; 3], |s, t| {
@@ -54,9 +42,10 @@ fn orient_up(m: &mut TriMesh) -> bool {
     }
 }
 
-pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result<Output> {
+/// The planar pipeline on inputs prepared by [`super::domain::prepare`] (stages continue `stages`).
+pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages: Stages) -> Result<Output> {
+    let Prepared { meshes: inputs, vertex_maps: repair_maps, repair: repair_reports, reason, .. } = prep;
     let k_in = inputs.len();
-    let mut stages = Stages::new();
 
     // 1. Validate: every input a disk.
     let (meshes, maps, conv, topo) = stages.run(progress, "validate", || {
@@ -73,14 +62,37 @@ pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result
             let info = trimesh::topology(&t);
             if !planar::is_disk(&info) {
                 return Err(Error::Topology(format!(
-                    "{}: input 0 is a disk, so the morph uses the planar domain and every input must be a \
-                     disk (connected, manifold, one boundary loop, genus 0); found {}",
+                    "{}: the morph uses the planar domain ({reason}), so every input must be a disk \
+                     (connected, manifold, one boundary loop, genus 0); found {}{}",
                     input_name(k),
-                    planar::describe(&info)
+                    planar::describe(&info),
+                    if params.repair {
+                        " after repair"
+                    } else if info.boundary_loops > 1
+                        || info.components > 1
+                        || planar::genus_of(&info).is_none()
+                    {
+                        " (`repair: true` mends holes, non-manifold parts and stray pieces)"
+                    } else {
+                        ""
+                    }
                 )));
             }
             ms.push(t);
-            maps.push(map);
+            // Input vertex → triangulated vertex, through the repair's map when there was one.
+            maps.push(match &repair_maps[k] {
+                Some(rm) => rm
+                    .iter()
+                    .map(|&r| {
+                        if r == u32::MAX {
+                            u32::MAX
+                        } else {
+                            map.get(r as usize).copied().unwrap_or(u32::MAX)
+                        }
+                    })
+                    .collect(),
+                None => map,
+            });
             convs.push(c);
             topo.push(info);
         }
@@ -234,12 +246,7 @@ pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result
         stages,
         params,
         progress,
-        Finish {
-            layer: &layer,
-            frames_out: &frames_out,
-            normalised: &normalised,
-            exact,
-        },
+        Finish { layer: &layer, frames_out: &frames_out, normalised: &normalised, exact },
     )
     .map(|(mut report, meshes, artifacts)| {
         let per_input: Vec<serde_json::Value> = (0..k_in)
@@ -258,6 +265,7 @@ pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result
             .collect();
         let extra = json!({
             "domain": "planar",
+            "domain_reason": reason,
             "angle_distortion": param_reports.iter().map(|r| r.angle_distortion).collect::<Vec<_>>(),
             "area_distortion": param_reports.iter().map(|r| r.area_distortion).collect::<Vec<_>>(),
             "foldovers": param_reports.iter().map(|r| r.foldovers).collect::<Vec<_>>(),
@@ -273,7 +281,7 @@ pub fn run(inputs: &[Mesh], params: &MorphParams, progress: &Progress) -> Result
             "common_boundary_vertices": common[0].bnd.iter().filter(|&&b| b != u32::MAX).count(),
             "features": align_rep,
             "icp": icp_reports,
-            "repair": if params.repair { json!("not applied: the inputs are already disks") } else { json!([]) },
+            "repair": repair_reports,
             "per_input": per_input,
         });
         if let (Some(r), Some(e)) = (report.as_object_mut(), extra.as_object()) {
@@ -296,7 +304,10 @@ fn map_features(features: &[Vec<u32>], maps: &[Vec<u32>], k_in: usize) -> Result
             if m == u32::MAX {
                 return Err(Error::params(
                     format!("features[{i}][{k}]"),
-                    format!("vertex {v} of {} does not exist or is used by no face", input_name(k)),
+                    format!(
+                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
+                        input_name(k)
+                    ),
                 ));
             }
             row.push(m);

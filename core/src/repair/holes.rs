@@ -35,6 +35,9 @@ pub struct FillOptions {
     pub dp_max_edges: usize,
     pub refine: bool,
     pub fair: bool,
+    /// Boundary edges (vertex pairs, either order) whose loops stay open, counted under the reason
+    /// "kept open" (the morph's disk domain keeps a disk's outer rim this way).
+    pub keep_open: Vec<[u32; 2]>,
 }
 
 impl From<&RepairParams> for FillOptions {
@@ -45,6 +48,7 @@ impl From<&RepairParams> for FillOptions {
             dp_max_edges: p.dp_max_edges,
             refine: p.refine,
             fair: p.fair,
+            keep_open: Vec::new(),
         }
     }
 }
@@ -97,8 +101,13 @@ pub fn fill(mesh: &mut Mesh, opts: &FillOptions, progress: &Progress) -> Result<
     };
     let mut created: HashSet<(u32, u32)> = HashSet::new();
     let mut new_faces: Vec<(Vec<u32>, u32)> = Vec::new();
+    let keep: HashSet<u32> = opts.keep_open.iter().filter_map(|e| topo.find_edge(e[0], e[1])).collect();
     for (li, lp) in loops.iter().enumerate() {
         progress.fraction(li as f64 / loops.len() as f64)?;
+        if lp.edges.iter().any(|e| keep.contains(e)) {
+            skip(&mut r, "kept open");
+            continue;
+        }
         if !lp.closed {
             skip(&mut r, "not a closed loop (non-manifold tangle)");
             continue;
@@ -550,6 +559,34 @@ mod tests {
         assert!(r.filled_edges.contains(&8));
         // Planar: every patch triangle is flat, inner patch area exactly 4, outer 16.
         assert!((r.area_added - 20.0).abs() < 1e-9, "{}", r.area_added);
+    }
+
+    #[test]
+    fn keep_open_leaves_the_named_loop_and_fills_the_rest() {
+        // As above (4×4 grid, 2×2 hole), but the rim is named by one of its edges (0–1, on y = 0):
+        // only the 8-edge inner hole is filled, with area 4.
+        let g = shapes::grid(4, 4, 1.0, true);
+        let mut faces = Faces::new();
+        for (i, f) in g.faces.iter().enumerate() {
+            let (cx, cy) = (i % 4, i / 4);
+            if !((1..3).contains(&cx) && (1..3).contains(&cy)) {
+                faces.push(f, 0);
+            }
+        }
+        let mut m = Mesh::new(g.positions, faces);
+        let opts = FillOptions {
+            refine: false,
+            fair: false,
+            max_hole_area_ratio: 10.0,
+            keep_open: vec![[1, 0]],
+            ..Default::default()
+        };
+        let r = fill(&mut m, &opts, &Progress::new()).unwrap();
+        assert_eq!((r.holes, r.filled, r.skipped), (2, 1, 1));
+        assert_eq!(r.filled_edges, vec![8]);
+        assert_eq!(r.skipped_by_reason.get("kept open"), Some(&1));
+        assert!((r.area_added - 4.0).abs() < 1e-9, "{}", r.area_added);
+        assert_eq!(analyze(&m).boundary_loops, 1);
     }
 
     #[test]

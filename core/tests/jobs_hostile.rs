@@ -1,0 +1,265 @@
+//! Every job on small hostile-but-readable meshes: degenerate, duplicated, non-manifold,
+//! disconnected, extreme-scale and polygon inputs. The readers accept all of these (they are
+//! structurally valid), so each job must answer with an output or a clear error, never a panic,
+//! and whatever it outputs must satisfy the mesh invariants with finite coordinates.
+//!
+//! The truth here is the contract, not a value: `Ok` with a valid mesh, or `Err` with a kind and
+//! a message.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use meshwork_core::error::Error;
+use meshwork_core::job::{run, JobKind};
+use meshwork_core::mesh::{Faces, Mesh, Point3};
+use meshwork_core::shapes::{grid, icosphere, torus};
+use meshwork_core::Progress;
+use serde_json::{json, Value};
+
+fn tris(p: Vec<Point3>, t: &[[u32; 3]]) -> Mesh {
+    Mesh::from_triangles(p, t)
+}
+
+fn scaled(mut m: Mesh, s: f64) -> Mesh {
+    for p in &mut m.positions {
+        for c in p.iter_mut() {
+            *c *= s;
+        }
+    }
+    m
+}
+
+/// The hostile set, each with a name for the failure message.
+fn hostile() -> Vec<(&'static str, Mesh)> {
+    let sq = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut out = vec![
+        ("one triangle", tris(sq[..3].to_vec(), &[[0, 1, 2]])),
+        ("collinear triangle", tris(vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]])),
+        ("all points coincident", tris(vec![[0.5; 3]; 4], &[[0, 1, 2], [0, 2, 3]])),
+        ("duplicate faces", tris(sq.clone(), &[[0, 1, 2], [0, 1, 2], [0, 2, 3]])),
+        ("two-sided face", tris(sq.clone(), &[[0, 1, 2], [0, 2, 1]])),
+        ("repeated index in a face", tris(sq.clone(), &[[0, 1, 1], [0, 2, 3]])),
+        (
+            "non-manifold edge (three fins)",
+            tris(
+                vec![[0.0; 3], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                &[[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+            ),
+        ),
+        (
+            "bowtie vertex",
+            tris(
+                vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [-1.0, -1.0, 0.0]],
+                &[[0, 1, 2], [0, 3, 4]],
+            ),
+        ),
+        ("unused vertices", tris([sq.clone(), vec![[9.0, 9.0, 9.0]; 3]].concat(), &[[0, 1, 2], [0, 2, 3]])),
+        ("inconsistent orientation", tris(sq.clone(), &[[0, 1, 2], [0, 3, 2]])),
+        ("sphere at 1e-30", scaled(icosphere(1, 1.0), 1e-30)),
+        ("sphere at 1e30", scaled(icosphere(1, 1.0), 1e30)),
+        ("quad grid", grid(3, 3, 1.0, true)),
+        ("torus", torus(8, 6, 1.0, 0.3, false)),
+    ];
+    // Two components far apart, one of them a lone triangle.
+    let mut two = icosphere(1, 1.0);
+    let n = two.positions.len() as u32;
+    two.positions.extend([[10.0, 0.0, 0.0], [11.0, 0.0, 0.0], [10.0, 1.0, 0.0]]);
+    two.faces.push(&[n, n + 1, n + 2], 0);
+    out.push(("sphere plus far triangle", two));
+    // One 200-gon (a regular polygon) and a degenerate pentagon with a repeated corner.
+    let ring: Vec<Point3> =
+        (0..200).map(|i| i as f64 * std::f64::consts::TAU / 200.0).map(|a| [a.cos(), a.sin(), 0.0]).collect();
+    let mut faces = Faces::new();
+    faces.push(&(0..200).collect::<Vec<u32>>(), 0);
+    out.push(("200-gon", Mesh::new(ring, faces)));
+    let mut faces = Faces::new();
+    faces.push(&[0, 1, 2, 2, 3], 0);
+    out.push(("pentagon with a repeated corner", Mesh::new(sq.clone(), faces)));
+    out
+}
+
+/// The single-mesh jobs and parameter sets to try on each hostile mesh.
+fn single_mesh_jobs() -> Vec<(JobKind, Value)> {
+    let mut v =
+        vec![(JobKind::Validate, json!({})), (JobKind::Convert, json!({})), (JobKind::Repair, json!({}))];
+    for m in ["laplacian", "taubin", "implicit", "mcf", "inflate", "tangential"] {
+        v.push((JobKind::Smooth, json!({ "method": m })));
+    }
+    v.push((JobKind::Smooth, json!({ "method": "fair", "region_all": true })));
+    v.push((JobKind::Smooth, json!({ "method": "highlight", "region_all": true })));
+    v
+}
+
+/// Runs one job, turning a panic into a failure line and checking an `Ok` output's meshes.
+fn check_job(what: &str, kind: JobKind, inputs: Vec<Mesh>, params: Value, failures: &mut Vec<String>) {
+    let got = catch_unwind(AssertUnwindSafe(|| run(kind, inputs, params.clone(), &Progress::new())));
+    match got {
+        Err(_) => failures.push(format!("{what}: {} {params}: PANIC", kind.name())),
+        Ok(Err(e)) => {
+            if std::env::var("HOSTILE_VERBOSE").is_ok() {
+                eprintln!("{what}: {} {params}: Err {e}", kind.name());
+            }
+            // An internal error is a 500 over HTTP: a bug, not an answer about the input.
+            if matches!(e, Error::Internal(_)) {
+                failures.push(format!("{what}: {} {params}: internal error: {e}", kind.name()));
+            }
+            if e.to_string().trim().is_empty() {
+                failures.push(format!("{what}: {} {params}: error with an empty message", kind.name()));
+            }
+        }
+        Ok(Ok(out)) => {
+            if std::env::var("HOSTILE_VERBOSE").is_ok() {
+                let f: Vec<usize> = out.meshes.iter().map(|m| m.face_count()).collect();
+                eprintln!(
+                    "{what}: {} {params}: Ok faces {f:?} warnings {}",
+                    kind.name(),
+                    out.report.get("warnings").map(|w| w.to_string()).unwrap_or_default()
+                );
+            }
+            for m in &out.meshes {
+                if let Err(e) = m.check() {
+                    failures.push(format!("{what}: {} {params}: output breaks invariants: {e}", kind.name()));
+                }
+            }
+            if !out.report.is_object() {
+                failures.push(format!("{what}: {} {params}: report is not a JSON object", kind.name()));
+            }
+        }
+    }
+}
+
+#[test]
+fn single_mesh_jobs_never_panic_on_hostile_meshes() {
+    let mut failures = Vec::new();
+    let mut runs = 0;
+    for (what, mesh) in hostile() {
+        mesh.check().unwrap_or_else(|e| panic!("test mesh {what} is not structurally valid: {e}"));
+        for (kind, params) in single_mesh_jobs() {
+            check_job(what, kind, vec![mesh.clone()], params, &mut failures);
+            runs += 1;
+        }
+    }
+    assert!(failures.is_empty(), "{} of {runs} runs failed:\n{}", failures.len(), failures.join("\n"));
+}
+
+#[test]
+fn morph_never_panics_on_hostile_pairs() {
+    let mut failures = Vec::new();
+    let sphere = icosphere(2, 1.0);
+    for (what, mesh) in hostile() {
+        for repair in [false, true] {
+            let params = json!({ "frames": 3, "repair": repair });
+            check_job(
+                what,
+                JobKind::Morph,
+                vec![sphere.clone(), mesh.clone()],
+                params.clone(),
+                &mut failures,
+            );
+            check_job(what, JobKind::Morph, vec![mesh.clone(), sphere.clone()], params, &mut failures);
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// A curve mesh: the given polylines as `curves` over their own vertices.
+fn curve_mesh(lines: &[Vec<Point3>]) -> Mesh {
+    let mut m = Mesh::new(Vec::new(), Faces::new());
+    for l in lines {
+        let base = m.positions.len() as u32;
+        m.positions.extend(l.iter().copied());
+        m.curves.push((base..base + l.len() as u32).collect());
+    }
+    m
+}
+
+#[test]
+fn fit_never_panics_on_hostile_templates_or_curves() {
+    let mut failures = Vec::new();
+    let circle = |z: f64, r: f64, n: usize| -> Vec<Point3> {
+        (0..=n)
+            .map(|i| i as f64 * std::f64::consts::TAU / n as f64)
+            .map(|a| [r * a.cos(), r * a.sin(), z])
+            .collect()
+    };
+    let good_curves = curve_mesh(&[circle(0.0, 1.0, 24), circle(0.5, 0.8, 24)]);
+    for (what, mesh) in hostile() {
+        check_job(what, JobKind::Fit, vec![mesh, good_curves.clone()], json!({}), &mut failures);
+    }
+    let sphere = icosphere(2, 1.0);
+    let hostile_curves: Vec<(&str, Mesh)> = vec![
+        ("no curves", curve_mesh(&[])),
+        ("one point", curve_mesh(&[vec![[0.0; 3]]])),
+        ("all curve points equal", curve_mesh(&[vec![[0.2; 3]; 10]])),
+        ("one straight line", curve_mesh(&[(0..10).map(|i| [i as f64 * 0.1, 0.0, 0.0]).collect()])),
+        ("coplanar circle", curve_mesh(&[circle(0.0, 1.0, 40)])),
+        ("curves 1e6 away", curve_mesh(&[circle(1e6, 1.0, 24), circle(1e6 + 0.5, 0.8, 24)])),
+        (
+            "back-and-forth polyline",
+            curve_mesh(&[vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]]),
+        ),
+        ("tiny circles", curve_mesh(&[circle(0.0, 1e-12, 24), circle(1e-12, 1e-12, 24)])),
+    ];
+    for (what, curves) in hostile_curves {
+        check_job(what, JobKind::Fit, vec![sphere.clone(), curves], json!({}), &mut failures);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Tiny deterministic generator (xorshift), so a failure names a reproducible seed.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+/// Random connectivity over random (sometimes coincident, sometimes coplanar) points: soups,
+/// fans, non-manifold edges and mixed polygon arities, all structurally valid.
+fn random_mesh(rng: &mut Rng) -> Mesh {
+    let nv = 3 + rng.below(30) as usize;
+    let flat = rng.below(4) == 0;
+    let mut pos: Vec<Point3> = (0..nv)
+        .map(|_| {
+            let mut c = || (rng.below(1000) as f64) / 250.0 - 2.0;
+            [c(), c(), if flat { 0.0 } else { c() }]
+        })
+        .collect();
+    if rng.below(3) == 0 {
+        let k = rng.below(nv as u64) as usize;
+        pos[k] = pos[0];
+    }
+    let mut faces = Faces::new();
+    for _ in 0..1 + rng.below(40) {
+        let arity = if rng.below(4) == 0 { 4 } else { 3 };
+        let f: Vec<u32> = (0..arity).map(|_| rng.below(nv as u64) as u32).collect();
+        faces.push(&f, 0);
+    }
+    Mesh::new(pos, faces)
+}
+
+#[test]
+fn random_meshes_never_panic() {
+    let mut failures = Vec::new();
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    for seed in 0..60 {
+        let mesh = random_mesh(&mut rng);
+        let what = format!("random mesh #{seed}");
+        for (kind, params) in single_mesh_jobs() {
+            check_job(&what, kind, vec![mesh.clone()], params, &mut failures);
+        }
+        check_job(
+            &what,
+            JobKind::Morph,
+            vec![icosphere(1, 1.0), mesh.clone()],
+            json!({ "frames": 2, "repair": true }),
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

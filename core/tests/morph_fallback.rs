@@ -1,0 +1,234 @@
+//! The guaranteed spherical fallback (Tutte map of the mesh minus one vertex, inverse
+//! stereographic projection, Möbius normalisation, fold-free relaxation), against truths computed
+//! here: spherical triangle areas by Van Oosterom–Strackee (a fold-free map whose signed areas add
+//! up to 4π covers the sphere exactly once), brute-force closest points for the end frames.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+use meshwork_core::geometry::{cross, dot, norm, sub};
+use meshwork_core::job::{self, JobKind, Progress};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::morph::param::{self, ParamSettings, SphereMethod};
+use meshwork_core::morph::sphere_fallback::{self, FallbackSettings};
+use meshwork_core::morph::trimesh::TriMesh;
+use meshwork_core::register;
+use meshwork_core::shapes;
+use meshwork_core::spatial::closest_on_triangle;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
+}
+
+fn load(name: &str) -> Mesh {
+    let p = root().join("../shared/meshes").join(name);
+    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
+}
+
+/// Signed area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee).
+fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
+    let num = dot(a, cross(b, c));
+    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
+    2.0 * num.atan2(den)
+}
+
+/// Every spherical triangle positive and the areas adding up to 4π: a bijection onto the sphere.
+fn assert_covers_sphere_once(name: &str, sphere: &[Point3], tris: &[[u32; 3]]) {
+    let mut total = 0.0;
+    for (i, p) in sphere.iter().enumerate() {
+        assert!((norm(*p) - 1.0).abs() < 1e-12, "{name}: vertex {i} off the unit sphere");
+    }
+    for tr in tris {
+        let a = spherical_area(sphere[tr[0] as usize], sphere[tr[1] as usize], sphere[tr[2] as usize]);
+        assert!(a > 0.0, "{name}: flipped spherical triangle {tr:?}");
+        total += a;
+    }
+    assert!((total - 4.0 * PI).abs() < 1e-6, "{name}: total spherical area {total}");
+}
+
+fn trimesh(m: &Mesh) -> TriMesh {
+    let (t, _, _) = TriMesh::from_mesh(m);
+    let f = register::pca_frame(&t.pos, &t.tris).to_normalised;
+    TriMesh { pos: t.pos.iter().map(|&p| f.apply(p)).collect(), tris: t.tris }
+}
+
+fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
+    let mut m = shapes::icosphere(levels, 1.0);
+    for p in &mut m.positions {
+        *p = [p[0] * axes[0], p[1] * axes[1], p[2] * axes[2]];
+    }
+    m
+}
+
+/// A dumbbell: two bulbs joined by a waist 8× thinner, 12 units long (icosphere level 4,
+/// x stretched, the cross-section scaled by 0.15 + 1.1·x²).
+fn dumbbell() -> Mesh {
+    let mut m = shapes::icosphere(4, 1.0);
+    for p in &mut m.positions {
+        let f = 0.15 + 1.1 * p[0] * p[0];
+        *p = [6.0 * p[0], f * p[1], f * p[2]];
+    }
+    m
+}
+
+/// A capsule 8 long and 0.6 thick, bent through 270° around the z axis: closed at both ends,
+/// far from convex.
+fn bent_tube() -> Mesh {
+    let mut m = shapes::icosphere(4, 1.0);
+    let r = 4.0 / (0.75 * PI);
+    for p in &mut m.positions {
+        let (x, y, z) = (4.0 * p[0], 0.3 * p[1], 0.3 * p[2]);
+        let th = x / r;
+        *p = [(r + y) * th.cos(), (r + y) * th.sin(), z];
+    }
+    m
+}
+
+fn tutte_settings() -> ParamSettings {
+    ParamSettings { sphere_method: SphereMethod::Tutte, ..Default::default() }
+}
+
+#[test]
+fn bare_tutte_map_is_an_embedding_on_analytic_shapes() {
+    // No relaxation: the construction alone (Tutte layout, lift, Möbius normalisation).
+    let shapes = [
+        ("icosphere", shapes::icosphere(3, 1.0)),
+        ("ellipsoid", ellipsoid(3, [2.0, 1.0, 0.5])),
+        ("dumbbell", dumbbell()),
+        ("bent tube", bent_tube()),
+    ];
+    for (name, m) in &shapes {
+        let t = trimesh(m);
+        let (sphere, rep) = sphere_fallback::parameterise(
+            &t,
+            &FallbackSettings { relax_sweeps: 0, relax_batch: 5 },
+            &Progress::new(),
+        )
+        .expect("fallback");
+        eprintln!("{name}: {rep:?}");
+        assert_eq!(sphere_fallback::count_foldovers_exact(&sphere, &t.tris), 0, "{name}");
+        assert_covers_sphere_once(name, &sphere, &t.tris);
+        // The Möbius normalisation never makes SD worse than its start.
+        assert!(rep.area_distortion_after_normalisation <= rep.area_distortion_before_normalisation);
+    }
+}
+
+#[test]
+fn tutte_fallback_with_relaxation_on_analytic_shapes() {
+    let shapes = [
+        ("icosphere", shapes::icosphere(3, 1.0)),
+        ("ellipsoid", ellipsoid(3, [2.0, 1.0, 0.5])),
+        ("dumbbell", dumbbell()),
+        ("bent tube", bent_tube()),
+    ];
+    for (name, m) in &shapes {
+        let t = trimesh(m);
+        let map = param::parameterise(&t, &tutte_settings(), &Progress::new()).expect("fallback");
+        let r = &map.report;
+        eprintln!(
+            "{name}: {} vertices, AD {:.3} SD {:.3} (bare Tutte AD {:.3} SD {:.3}), {:?}",
+            t.pos.len(),
+            r.angle_distortion,
+            r.area_distortion,
+            r.tutte.as_ref().unwrap().angle_distortion_tutte,
+            r.tutte.as_ref().unwrap().area_distortion_tutte,
+            r.timings_ms
+        );
+        assert_eq!(r.param_method, "fallback_tutte");
+        assert_eq!(r.foldovers, 0, "{name}");
+        assert_covers_sphere_once(name, &map.sphere, &t.tris);
+        if *name == "icosphere" {
+            // A sphere's own map is nearly isometric after normalisation: the chord triangles of
+            // an icosphere are the triangles themselves up to a rotation.
+            assert!(r.angle_distortion < 0.05 && r.area_distortion < 0.1, "{r:?}");
+        }
+    }
+}
+
+#[test]
+fn tutte_fallback_on_a_shared_mesh() {
+    let t = trimesh(&load("homer.obj"));
+    let map = param::parameterise(&t, &tutte_settings(), &Progress::new()).expect("fallback");
+    let r = &map.report;
+    eprintln!("homer: AD {:.3} SD {:.3}: {:?}", r.angle_distortion, r.area_distortion, r.tutte);
+    assert_eq!(r.foldovers, 0);
+    assert_covers_sphere_once("homer", &map.sphere, &t.tris);
+}
+
+#[test]
+fn a_failing_progressive_path_falls_back_and_says_why() {
+    let t = trimesh(&ellipsoid(3, [1.5, 1.0, 0.7]));
+    let s = ParamSettings { inject_progressive_failure: true, ..Default::default() };
+    let map = param::parameterise(&t, &s, &Progress::new()).expect("auto falls back");
+    assert_eq!(map.report.param_method, "fallback_tutte");
+    let why = map.report.param_fallback_reason.as_deref().expect("reason");
+    assert!(why.contains("progressive") && why.contains("injected"), "{why}");
+    assert_eq!(map.report.foldovers, 0);
+    assert_covers_sphere_once("ellipsoid", &map.sphere, &t.tris);
+    // Without the fallback the failure is the job's answer.
+    let only = ParamSettings { sphere_method: SphereMethod::Progressive, ..s.clone() };
+    assert!(param::parameterise(&t, &only, &Progress::new()).is_err());
+    // And without the hook the progressive map is used and says so.
+    let normal = param::parameterise(&t, &ParamSettings::default(), &Progress::new()).expect("progressive");
+    assert_eq!(normal.report.param_method, "progressive");
+    assert!(normal.report.param_fallback_reason.is_none());
+}
+
+/// Max over `pts` of the distance to the nearest triangle of (pos, tris), by brute force.
+fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
+    pts.iter()
+        .map(|&p| {
+            tris.iter()
+                .map(|t| {
+                    norm(sub(
+                        p,
+                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
+                    ))
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+fn bbox_diag(p: &[Point3]) -> f64 {
+    meshwork_core::geometry::Aabb::of(p).expect("non-empty").diagonal()
+}
+
+#[test]
+fn morph_with_the_fallback_reproduces_both_inputs() {
+    let a = ellipsoid(3, [1.0, 1.2, 0.8]);
+    let b = dumbbell_small();
+    let out = job::run(
+        JobKind::Morph,
+        vec![a.clone(), b.clone()],
+        serde_json::json!({"registration": "none", "frames": 3, "sphere_method": "tutte"}),
+        &Progress::new(),
+    )
+    .expect("morph");
+    let rep = &out.report;
+    assert_eq!(rep["param_method"], serde_json::json!(["fallback_tutte", "fallback_tutte"]));
+    assert_eq!(rep["foldovers"], serde_json::json!([0, 0]));
+    assert!(rep["param_fallback_reason"][0].as_str().unwrap().contains("tutte"));
+    // Hausdorff both ways, brute force: metamesh in each input's shape vs the input.
+    for (k, m) in [&a, &b].into_iter().enumerate() {
+        let tm = shapes::fan_triangles(&m.faces);
+        let mm = &out.meshes[k].positions;
+        let tmm = shapes::fan_triangles(&out.meshes[k].faces);
+        let d = max_dist_brute(mm, &m.positions, &tm).max(max_dist_brute(&m.positions, mm, &tmm))
+            / bbox_diag(&m.positions);
+        assert!(d <= 1e-3, "input {k}: Hausdorff {d}");
+    }
+    assert!(rep["hausdorff_first_frame"].as_f64().unwrap() <= 1e-3);
+    assert!(rep["hausdorff_last_frame"].as_f64().unwrap() <= 1e-3);
+}
+
+/// A level-3 dumbbell (642 vertices) for the end-to-end morph.
+fn dumbbell_small() -> Mesh {
+    let mut m = shapes::icosphere(3, 1.0);
+    for p in &mut m.positions {
+        let f = 0.2 + p[0] * p[0];
+        *p = [4.0 * p[0], f * p[1], f * p[2]];
+    }
+    m
+}
