@@ -247,6 +247,7 @@ fn face_quality(pos: &[Point3], t: [u32; 3]) -> f64 {
     min_angle_quality(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
 }
 
+#[allow(clippy::too_many_arguments)]
 /// Moves `pos` from `old` to `proposed` where that is safe (see the module doc); `reproject`
 /// puts a halved step back on the surface. Returns the vertices whose step was halved and kept
 /// (their reference face may need updating).
