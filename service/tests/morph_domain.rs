@@ -1,6 +1,7 @@
 //! `meshwork morph --domain … --repair`: the morph's domain parameter through the command line
 //! (the generic `--some-name VALUE` → `some_name` mapping), on the shared disk woody with a hole
-//! punched into it, and the refusal of a closed mesh under `--domain disk`.
+//! punched into it, and the refusal of a closed mesh under `--domain disk`; the same over HTTP
+//! (`?domain=disk&repair=true`).
 
 mod common;
 
@@ -8,7 +9,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-use common::{shared_mesh, BIN, TETRA_OBJ};
+use common::{file_part, shared_mesh, Server, BIN, TETRA_OBJ};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::Mesh;
 
@@ -114,4 +115,38 @@ fn domain_flag_repairs_a_holed_disk_and_refuses_a_closed_one() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("genus 0 with 0 boundary loops"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(dir());
+}
+
+#[test]
+fn domain_query_parameter_over_http() {
+    let s = Server::start(&[]);
+    let (holed, _) = holed_woody();
+    let a = meshwork_core::io::obj::write(&holed).unwrap();
+    let b = std::fs::read(shared_mesh("alligator.obj")).unwrap();
+    let r = s.post_multipart(
+        "/v1/morph?frames=2&repair=true&domain=disk",
+        &[file_part("mesh", "a.obj", &a), file_part("mesh", "b.obj", &b)],
+    );
+    assert_eq!(r.status, 200, "{}", r.text());
+    assert_eq!(&r.body[..4], b"glTF");
+    let link = r.header("link").expect("Link to the report").to_string();
+    let path = link.trim_start_matches('<').split('>').next().unwrap().to_string();
+    let rep = s.get(&path).json();
+    assert_eq!(rep["domain"], "planar", "{rep}");
+    assert_eq!(rep["repair"][0]["summary"]["holes_filled"], 1);
+    // A closed mesh under domain=disk, and an unknown domain.
+    let t = TETRA_OBJ.as_bytes();
+    let p = s
+        .post_multipart(
+            "/v1/morph?domain=disk",
+            &[file_part("mesh", "t.obj", t), file_part("mesh", "b.obj", &b)],
+        )
+        .problem(422, "unsupported-topology");
+    assert!(p["detail"].as_str().unwrap().contains("genus 0 with 0 boundary loops"), "{p}");
+    s.post_multipart(
+        "/v1/morph?domain=torus",
+        &[file_part("mesh", "t.obj", t), file_part("mesh", "b.obj", &b)],
+    )
+    .problem(422, "invalid-params");
+    s.terminate();
 }
