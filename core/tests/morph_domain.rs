@@ -237,6 +237,7 @@ fn disk_with_an_extra_hole_is_morphed_after_repair_with_domain_disk_and_auto() {
         assert_eq!(s0["outer_boundary_edges"], SEG, "{s0}");
         let outer = &rep[0]["holes"]["outer_boundary"];
         assert!((outer["length"].as_f64().unwrap() - rim_length()).abs() < 1e-9, "{outer}");
+        assert_eq!(outer["also_largest_vector_area"], true, "{outer}");
         assert_eq!(rep[0]["holes"]["loops"].as_array().unwrap().len(), 2);
         assert_eq!(rep[0]["holes"]["fill"]["skipped_by_reason"]["kept open"], 1);
         // The vertices in and out add up: the vertices only the removed faces used (counted here)
@@ -408,4 +409,158 @@ fn auto_rule_on_analytic_and_shared_meshes() {
         );
         assert_eq!(c, want, "{name}: {why}");
     }
+}
+
+/// Feature indices refer to the input files: through the repair (which drops the vertices only the
+/// hole's faces used, renumbering the rest) a pair still means the same two points, and they meet.
+#[test]
+fn feature_indices_survive_the_repair_renumbering() {
+    let (damaged, _) = holed_hemisphere();
+    let used: std::collections::HashSet<u32> = tris_of(&damaged).into_iter().flatten().collect();
+    let first_dropped =
+        (0..damaged.positions.len() as u32).find(|v| !used.contains(v)).expect("a dropped vertex");
+    // A source vertex numbered after the dropped one (so its index shifts), away from the rim.
+    let va = (first_dropped + 1..damaged.positions.len() as u32)
+        .find(|v| used.contains(v) && damaged.positions[*v as usize][2] > 0.3)
+        .expect("a later vertex");
+    let target = paraboloid(10);
+    let vb = (0..target.positions.len() as u32)
+        .min_by(|&i, &j| {
+            let d = |k: u32| target.positions[k as usize][0].hypot(target.positions[k as usize][1] + 0.3);
+            d(i).total_cmp(&d(j))
+        })
+        .unwrap();
+    let out = morph(
+        vec![damaged.clone(), target.clone()],
+        json!({"repair": true, "domain": "disk", "registration": "none", "frames": 3, "features": [[va, vb]]}),
+    );
+    assert_eq!(out.report["features"]["foldovers"], 0, "{}", out.report["features"]);
+    let (m0, m1) = (&out.meshes[0].positions, &out.meshes[1].positions);
+    // The metamesh vertex at the source vertex (input 0's coordinates, through the normalising
+    // similarity and back: equal up to round-off).
+    let pa = damaged.positions[va as usize];
+    let k = (0..m0.len()).min_by(|&i, &j| norm(sub(m0[i], pa)).total_cmp(&norm(sub(m0[j], pa)))).unwrap();
+    assert!(norm(sub(m0[k], pa)) < 1e-9, "source vertex not in the metamesh");
+    let gap = norm(sub(m1[k], target.positions[vb as usize])) / diag(&target.positions);
+    assert!(gap < 1e-3, "feature ({va}, {vb}) ends {gap} apart; {}", out.report["features"]);
+}
+
+/// A hole touching the rim at one vertex (a pinch: the two loops share it): the one-triangle hole
+/// is filled (with that very triangle, the only way to close three edges), the rim kept, and the
+/// first frame is the undamaged hemisphere.
+#[test]
+fn hole_touching_the_rim_at_a_vertex_is_filled() {
+    let h = hemisphere();
+    let mut t = tris_of(&h);
+    // The last band's triangle [a, d, b] of segment 5: d on the rim, a and b on the ring above.
+    let idx = SEG + (RINGS - 2) * 2 * SEG + 2 * 5 + 1;
+    let on_rim = t[idx].iter().filter(|&&v| h.positions[v as usize][2].abs() < 1e-12).count();
+    assert_eq!(on_rim, 1);
+    t.remove(idx);
+    let m = Mesh::from_triangles(h.positions.clone(), &t);
+    for dom in ["disk", "auto"] {
+        let out = morph(vec![m.clone(), paraboloid(8)], json!({"repair": true, "domain": dom, "frames": 3}));
+        let r = &out.report;
+        assert_eq!(r["domain"], "planar", "{}", r["domain_reason"]);
+        let s = &r["repair"][0]["summary"];
+        assert_eq!((s["holes_filled"].as_u64(), s["faces_added"].as_u64()), (Some(1), Some(1)), "{s}");
+        assert_eq!(s["outer_boundary_edges"], SEG, "{s}");
+        let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
+        let d = h
+            .positions
+            .iter()
+            .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+            .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
+            .fold(0.0, f64::max)
+            / diag(&h.positions);
+        assert!(d < 1e-9, "first frame vs hemisphere {d}");
+        assert!((area(&out.meshes[0]) / area(&h) - 1.0).abs() < 1e-12);
+    }
+}
+
+/// The hemisphere cut open along the seam between segments SEG−1 and 0 (the faces of that strip
+/// use duplicates of the segment-0 vertices, as an exporter splitting UV seams writes it): the
+/// repair's weld merges one duplicate per ring, counted in the summary, and the first frame is the
+/// closed-up hemisphere.
+#[test]
+fn welded_seam_is_counted_and_the_surface_restored() {
+    let h = hemisphere();
+    let mut pos = h.positions.clone();
+    let id = |i: usize, j: usize| (1 + (i - 1) * SEG + j) as u32;
+    let first: Vec<u32> = (1..=RINGS).map(|i| id(i, 0)).collect();
+    let last: Vec<u32> = (1..=RINGS).map(|i| id(i, SEG - 1)).collect();
+    let mut dup = std::collections::HashMap::new();
+    let tris: Vec<[u32; 3]> = tris_of(&h)
+        .into_iter()
+        .map(|t| {
+            if !t.iter().any(|v| last.contains(v)) {
+                return t;
+            }
+            t.map(|v| {
+                if first.contains(&v) {
+                    *dup.entry(v).or_insert_with(|| {
+                        pos.push(h.positions[v as usize]);
+                        (pos.len() - 1) as u32
+                    })
+                } else {
+                    v
+                }
+            })
+        })
+        .collect();
+    assert_eq!(dup.len(), RINGS);
+    let cut = Mesh::from_triangles(pos, &tris);
+    let out = morph(vec![cut.clone(), paraboloid(8)], json!({"repair": true, "frames": 3}));
+    let r = &out.report;
+    assert_eq!(r["domain"], "planar", "{}", r["domain_reason"]);
+    let s = &r["repair"][0]["summary"];
+    assert_eq!(s["vertices_in"], h.positions.len() + RINGS, "{s}");
+    assert_eq!(s["vertices_merged"], RINGS, "{s}");
+    assert_eq!(s["vertices_removed_unreferenced"], RINGS, "{s}");
+    assert_eq!(s["vertices_out"], h.positions.len(), "{s}");
+    assert_eq!(s["holes_filled"], 0, "{s}");
+    let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
+    let d = h
+        .positions
+        .iter()
+        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
+        .fold(0.0, f64::max)
+        / diag(&h.positions);
+    assert!(d < 1e-9, "first frame vs hemisphere {d}");
+    // The rim is the hemisphere's again: SEG edges on the equator.
+    assert!(boundary_edges(&out.meshes[0])
+        .iter()
+        .all(|&(a, b)| { [a, b].iter().all(|&v| out.meshes[0].positions[v as usize][2].abs() < 1e-9) }));
+}
+
+/// A closed surface with one small hole is topologically a disk: without `repair` it takes the
+/// planar domain as it is; with `repair: true` the auto rule sees no rim (the hole spans a few % of
+/// the diagonal) and closes it for the spherical domain.
+#[test]
+fn sphere_with_one_small_hole_is_a_disk_as_is_and_a_sphere_after_repair() {
+    let s = shapes::icosphere(2, 1.0);
+    let mut t = tris_of(&s);
+    t.remove(7);
+    let holed = Mesh::from_triangles(s.positions.clone(), &t);
+    let target = shapes::icosphere(1, 1.0);
+    let out = morph(vec![holed.clone(), paraboloid(6)], json!({"frames": 2}));
+    assert_eq!(out.report["domain"], "planar", "{}", out.report["domain_reason"]);
+    let out = morph(vec![holed, target], json!({"frames": 2, "repair": true}));
+    let r = &out.report;
+    assert_eq!(r["domain"], "spherical", "{}", r["domain_reason"]);
+    assert!(r["domain_reason"].as_str().unwrap().contains("no loop is a rim"), "{}", r["domain_reason"]);
+    assert_eq!(r["repair"][0]["summary"]["holes_filled"], 1);
+    assert_eq!(r["repair"][0]["summary"]["faces_added"], 1);
+    assert_eq!(r["foldovers"], json!([0, 0]));
+    // The one-triangle hole is closed by that triangle: the first frame is the icosphere.
+    let (st, ft) = (tris_of(&s), tris_of(&out.meshes[0]));
+    let d = s
+        .positions
+        .iter()
+        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
+        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &s.positions, &st)))
+        .fold(0.0, f64::max)
+        / diag(&s.positions);
+    assert!(d < 1e-9, "first frame vs icosphere {d}");
 }

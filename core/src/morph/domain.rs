@@ -313,7 +313,19 @@ fn fill_for(
     };
     let rep = json!({
         "loops": loops,
-        "outer_boundary": outer.as_ref().map(|o| json!({"edges": o.edges, "length": o.length, "span": o.span})),
+        "outer_boundary": outer.as_ref().map(|o| {
+            // Length picks the rim; when another loop bounds a larger projected area the choice is
+            // not clear-cut, and the user may want to look (or pick the domain differently).
+            let by_area = loops.iter().map(|l| l.vector_area).fold(0.0, f64::max);
+            json!({
+                "rule": "longest boundary loop",
+                "edges": o.edges,
+                "length": o.length,
+                "span": o.span,
+                "vector_area": o.vector_area,
+                "also_largest_vector_area": o.vector_area >= by_area,
+            })
+        }),
         "fill": fill,
         "non_manifold_after_fill": nm,
     });

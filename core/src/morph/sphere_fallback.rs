@@ -448,14 +448,15 @@ fn lift_all(plane: &[[f64; 2]], v0: u32, s: f64, t: [f64; 2]) -> Vec<Point3> {
         .collect()
 }
 
-/// SD of the lifted map, or +∞ if any chord triangle is not positive (fast test; the caller
-/// verifies the winner exactly).
+/// SD of the lifted map, or +∞ if any chord triangle is not positive. The test is the exact one:
+/// small lifted triangles have dets far below the rounding error of the naive formula (terms of
+/// order h cancel to h²), which would reject valid layouts.
 fn lifted_sd(mesh: &TriMesh, area3: &[f64], total3: f64, sphere: &[Point3]) -> f64 {
     let mut a2 = Vec::with_capacity(mesh.tris.len());
     let mut total2 = 0.0;
     for t in &mesh.tris {
         let q = t.map(|v| sphere[v as usize]);
-        if !(param::orient(q[0], q[1], q[2]) > 0.0) {
+        if orient_sign(q[0], q[1], q[2]) <= 0 {
             return f64::INFINITY;
         }
         let a = triangle_area(q[0], q[1], q[2]);
