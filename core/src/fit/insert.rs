@@ -81,7 +81,8 @@ pub fn insert_curve_points(
             vf[v as usize].push(f as u32);
         }
     }
-    let mut feet = feet(pos, tris, &vf, &net.points)?;
+    let all: Vec<u32> = (0..n as u32).collect();
+    let mut feet = feet(pos, tris, &vf, &net.points, &all)?;
     let on_rim = super::ends::boundary_feet(pos, tris, net, end_snap);
     for b in &on_rim {
         feet[b.point_index as usize] = (b.face, b.foot, b.distance);
@@ -208,16 +209,18 @@ pub fn insert_curve_points(
 
 /// Closest point of each curve point on the template: (face, point, distance). Candidates are the
 /// faces of the nearest template vertex's two-ring (exact for points near a reasonable surface).
-fn feet(
+pub(crate) fn feet(
     pos: &[Point3],
     tris: &[[u32; 3]],
     vf: &[Vec<u32>],
     points: &[Point3],
+    which: &[u32],
 ) -> Result<Vec<(u32, Point3, f64)>> {
     let tree = KdTree::new(pos);
-    let mut out = Vec::with_capacity(points.len());
+    let mut out = Vec::with_capacity(which.len());
     let mut cand: Vec<u32> = Vec::new();
-    for (i, &p) in points.iter().enumerate() {
+    for &i in which {
+        let p = points[i as usize];
         let (v, _) = tree.nearest(p).ok_or_else(|| Error::Internal("empty template".into()))?;
         cand.clear();
         for &f in &vf[v as usize] {

@@ -15,6 +15,7 @@
 //! The output mesh has one face group per region and carries the curves as vertex chains.
 
 pub mod align;
+pub mod approach;
 pub mod correspond;
 pub mod curves;
 pub mod ends;
@@ -29,8 +30,7 @@ pub mod retriangulate;
 pub mod smooth;
 pub mod testdata;
 pub mod trimesh;
-
-use std::collections::HashSet;
+pub mod untangle;
 
 use serde::{Deserialize, Serialize};
 
@@ -112,6 +112,9 @@ pub struct FitParams {
     pub end_snap: f64,
     /// Cap on detect-flips / subdivide / re-fit rounds.
     pub max_flip_iterations: u32,
+    /// Levels of the approach to the curves before the exact fine fit (RBFs through ¼, 1/16,
+    /// 1/64 … of the curve vertices, sparsest first; 0 = fit in one step as the seed does).
+    pub approach_levels: u32,
     /// A segment crossing an edge within this fraction of its length from a vertex snaps the
     /// vertex onto the segment (0 disables; at most 0.5).
     pub snap_fraction: f64,
@@ -139,6 +142,7 @@ impl Default for FitParams {
             max_curve_distance: 0.25,
             end_snap: 0.05,
             max_flip_iterations: 4,
+            approach_levels: 3,
             snap_fraction: 0.3,
             smooth: true,
             mcf_iterations: 10,
@@ -166,6 +170,9 @@ impl FitParams {
         }
         if !(self.mcf_step.is_finite() && self.mcf_step > 0.0 && self.mcf_step <= 1.0) {
             return bad("mcf_step", "must be in (0, 1]");
+        }
+        if self.approach_levels > 6 {
+            return bad("approach_levels", "must be ≤ 6");
         }
         if self.max_flip_iterations > 20 {
             return bad("max_flip_iterations", "must be ≤ 20");
@@ -216,21 +223,38 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
-    let fine = stages.run(progress, "fine", || match params.matching {
-        Matching::Insert => fine_fit_inserted(
-            &mut pos,
-            &mut tris,
-            &net,
-            &coarse,
-            params,
-            template_diag,
-            &mut parents,
-            progress,
-        ),
-        Matching::NearestVertex => {
-            fine_fit(&mut pos, &mut tris, &net, &coarse, params, template_diag, &mut parents, progress)
-        }
+    let fine = stages.run(progress, "fine", || {
+        let clock = std::time::Instant::now();
+        let pair_fixed: Vec<(u32, u32)> = coarse
+            .pair_curve_points
+            .iter()
+            .zip(&params.pairs)
+            .map(|(&p, pr)| (p, pr.template_vertex))
+            .collect();
+        let levels = params.approach_levels as usize;
+        let limit = params.max_curve_distance * template_diag;
+        let approach =
+            approach::approach(&mut pos, &tris, &net, &pair_fixed, params.kernel, levels, limit, progress)?;
+        let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
+        let mut fine =
+            fine_dispatch(&mut pos, &mut tris, &net, &coarse, params, template_diag, &mut parents, progress)?;
+        fine.report.approach = Some(approach);
+        fine.report.approach_ms = approach_ms;
+        Ok(fine)
     })?;
+
+    // Folds the fine deformation left (faces turned against the surface before it) are undone by
+    // local edge flips and ring-mean moves of non-curve vertices.
+    let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), std::mem::take(&mut tris))?;
+    let untangle_fine = stages.run(progress, "untangle_fine", || {
+        let reference = report::vertex_normals(&pos, &mesh.tris);
+        let mut fixed = vec![false; pos.len()];
+        for &v in &fine.vertex_of_point {
+            fixed[v as usize] = true;
+        }
+        Ok(untangle::untangle(&mut mesh, &reference, &fixed, &untangle::EdgeSet::default(), 8))
+    })?;
+    let tris = mesh.live_triangles();
 
     // The template's own face groups, when it has several, are intersected with the regions.
     let keep_groups = template.groups.len() > 1
@@ -255,19 +279,25 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         Vec::new()
     };
     let fine_tris = if keep_groups { tris.clone() } else { Vec::new() };
-    let reference_normals = report::vertex_normals(&fine.positions, &tris);
-    let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), tris)?;
+    let fine_positions = mesh.pos.clone();
+    let reference_normals = report::vertex_normals(&fine_positions, &tris);
     let realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
-    let out_tris = mesh.live_triangles();
-    let mut curve_edges = HashSet::<(u32, u32), std::hash::BuildHasherDefault<trimesh::IntHasher>>::default();
+    let mut curve_edges = untangle::EdgeSet::default();
     for c in &realised.chains {
         for p in c.windows(2) {
             curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
         }
     }
-    let (region, region_count) =
+    // Folds made by snapping vertices onto segments and by the re-triangulated strips, against the
+    // fine surface; chain vertices stay fixed and curve edges locked.
+    let untangle_retri = stages.run(progress, "untangle_retriangulated", || {
+        // (Boundary vertices are never moved by the untangling either.)
+        Ok(untangle::untangle(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
+    })?;
+    let mut out_tris = mesh.live_triangles();
+    let (mut region, mut region_count) =
         stages.run(progress, "partition", || Ok(partition::regions(&out_tris, &curve_edges)))?;
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
     let mut out_pos = mesh.pos.clone();
@@ -284,6 +314,24 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
         })?;
     }
+    // Smoothing moves free vertices by tangential steps that can fold a face in a tight spot: the
+    // same untangling, against the same reference, on the smoothed positions.
+    let untangle_smoothed = if params.smooth {
+        mesh.pos = out_pos;
+        let s = stages.run(progress, "untangle_smoothed", || {
+            Ok(untangle::untangle(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
+        })?;
+        out_pos = mesh.pos.clone();
+        if s.edge_flips > 0 {
+            // Flipped edges are never curve edges, so regions are unchanged; the labels are
+            // recomputed for the new face list.
+            out_tris = mesh.live_triangles();
+            (region, region_count) = partition::regions(&out_tris, &curve_edges);
+        }
+        Some(s)
+    } else {
+        None
+    };
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
     // Output mesh: one group per region (per region × template group when the template had
@@ -318,7 +366,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &fine.vertex_of_point,
             &realised,
             &out_tris,
-            &fine.positions,
+            &fine_positions,
             &reference_normals,
         ))
     })?;
@@ -337,6 +385,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "alignment": coarse,
         "fine": fine.report,
         "retriangulation": realised.stats,
+        "untangle": { "fine": untangle_fine, "retriangulated": untangle_retri, "smoothed": untangle_smoothed },
         "regions": region_count,
         "curve_residual_max": quality.curve_residual_max,
         "curve_residual_mean": quality.curve_residual_mean,
@@ -603,6 +652,9 @@ pub struct FineReport {
     pub insertion: Option<insert::InsertStats>,
     /// Milliseconds per step of the fine stage (matching = insert): insert, solve, evaluate, flips.
     pub steps_ms: Option<[f64; 4]>,
+    /// The multi-level approach to the curves before the exact fit (see [`approach`]).
+    pub approach: Option<approach::ApproachReport>,
+    pub approach_ms: f64,
 }
 
 /// Fails, naming the curve, when a curve vertex is farther than the limit from its template vertex.
@@ -626,6 +678,26 @@ fn check_distances(
         ));
     }
     Ok(())
+}
+
+/// The fine stage proper, by matching rule.
+#[allow(clippy::too_many_arguments)]
+fn fine_dispatch(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    progress: &Progress,
+) -> Result<Fine> {
+    match params.matching {
+        Matching::Insert => {
+            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, progress)
+        }
+        Matching::NearestVertex => fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress),
+    }
 }
 
 /// The fine stage with `Matching::Insert`: split the template at the curve vertices' feet, solve
@@ -722,6 +794,8 @@ fn fine_fit_inserted(
             matching: "insert",
             insertion: Some(ins.stats),
             steps_ms: Some(steps_ms),
+            approach: None,
+            approach_ms: 0.0,
         },
     })
 }
@@ -799,6 +873,8 @@ fn fine_fit(
                 matching: "nearest_vertex",
                 insertion: None,
                 steps_ms: None,
+                approach: None,
+                approach_ms: 0.0,
             },
         };
         // Keep the round with the fewest flips; a round that does not improve stops the loop

@@ -19,6 +19,8 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashSet};
 use std::hash::BuildHasherDefault;
 
+use serde::Serialize;
+
 use crate::error::Result;
 use crate::geometry::{add, cross, dot, norm, normalize, scale, sub};
 use crate::job::Progress;
@@ -29,7 +31,7 @@ use super::trimesh::{IntHasher, IntMap, TriMesh};
 
 type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
 
-#[derive(Debug, Clone, Default, serde::Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct RetriStats {
     pub segments: usize,
     /// Segments that were mesh edges already.
@@ -50,6 +52,21 @@ pub struct RetriStats {
     pub walk_fail_curve_edge: usize,
     pub walk_fail_lost: usize,
     pub walk_fail_fill: usize,
+    /// The first segments that could not be realised (up to 20): why the walk stopped and
+    /// whether the fallback ran, for diagnosis.
+    pub failed: Vec<FailedSegment>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FailedSegment {
+    /// Index into the network's segments, and its two curve points.
+    pub segment: usize,
+    pub points: [u32; 2],
+    /// Mesh vertices of the ends and where the walk stopped.
+    pub vertices: [u32; 2],
+    pub stopped_at: u32,
+    /// "start", "boundary", "curve_edge", "lost" or "fill".
+    pub walk: &'static str,
 }
 
 pub struct Realised {
@@ -58,6 +75,24 @@ pub struct Realised {
     /// Vertices on some chain (curve vertices and those added to chains).
     pub on_curve: Vec<bool>,
     pub stats: RetriStats,
+}
+
+impl RetriStats {
+    fn clone_counts(&self) -> [usize; 5] {
+        [
+            self.walk_fail_start,
+            self.walk_fail_boundary,
+            self.walk_fail_curve_edge,
+            self.walk_fail_lost,
+            self.walk_fail_fill,
+        ]
+    }
+    /// The walk failure counted since `before` (the last one when several pieces failed).
+    fn fail_reason_since(&self, before: [usize; 5]) -> &'static str {
+        let now = self.clone_counts();
+        let names = ["start", "boundary", "curve_edge", "lost", "fill"];
+        (0..5).rev().find(|&k| now[k] > before[k]).map_or("unknown", |k| names[k])
+    }
 }
 
 /// The plane through the segment that contains the mean surface normal.
@@ -126,6 +161,7 @@ pub fn realise(
             stats.already_edges += 1;
             chain.push(w);
         } else {
+            let before = stats.clone_counts();
             let ok =
                 walk_segment(mesh, u, w, snap_fraction, &mut on_curve, &locked_edges, &mut chain, &mut stats);
             if ok {
@@ -143,6 +179,16 @@ pub fn realise(
                         }
                     }
                     None => {
+                        if stats.failed.len() < 20 {
+                            let walk = stats.fail_reason_since(before);
+                            stats.failed.push(FailedSegment {
+                                segment: si,
+                                points: *seg,
+                                vertices: [u, w],
+                                stopped_at: from,
+                                walk,
+                            });
+                        }
                         stats.failed_segments += 1;
                         chain.push(w);
                     }

@@ -1,0 +1,243 @@
+//! Untangling folded faces: a face is *folded* when its normal opposes (or is perpendicular to,
+//! within [`MIN_COS`]) the reference normal of its corners (vertex normals of an earlier, unfolded state of the same mesh). Used twice: after the
+//! fine deformation (reference: the surface before it; curve vertices fixed) and after the
+//! re-triangulation (reference: the fine surface; chain vertices fixed, curve edges locked).
+//!
+//! Fixes are local and only accepted when they leave no folded face among the faces they touch
+//! and strictly reduce the folded count there:
+//! 1. flip a non-curve edge of the folded face (its two faces become two others of the same quad);
+//!    this is the only fix when all three corners are fixed curve vertices;
+//! 2. move a free corner (or a free vertex one ring further out) to the mean of its ring, first
+//!    tangentially (keeps the surface), then fully.
+//!
+//! Positions of fixed vertices never change, so curve vertices stay exact.
+
+use std::collections::HashSet;
+use std::hash::BuildHasherDefault;
+
+use serde::Serialize;
+
+use crate::geometry::{add, dot, scale, sub, triangle_cross};
+use crate::mesh::Point3;
+
+use super::trimesh::{IntHasher, TriMesh};
+
+/// A face counts as folded when its normal is within this cosine of perpendicular to the reference
+/// (or beyond): a face standing on its edge, e.g. three consecutive vertices of one planar curve,
+/// is as wrong as a flipped one and one round-off away from it.
+const MIN_COS: f64 = 0.05;
+
+pub type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
+
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct UntangleStats {
+    pub folded_before: usize,
+    pub edge_flips: usize,
+    pub vertex_moves: usize,
+    pub folded_after: usize,
+}
+
+struct Ctx<'a> {
+    reference: &'a [Point3],
+    fixed: &'a [bool],
+    locked: &'a EdgeSet,
+}
+
+impl Ctx<'_> {
+    fn reference_of(&self, t: [u32; 3]) -> Point3 {
+        add(add(self.reference[t[0] as usize], self.reference[t[1] as usize]), self.reference[t[2] as usize])
+    }
+    /// Cosine between triangle `t`'s normal (corner positions from `p`) and its reference normal;
+    /// 0 for a degenerate triangle or reference.
+    fn score(&self, t: [u32; 3], p: impl Fn(u32) -> Point3) -> f64 {
+        let n = triangle_cross(p(t[0]), p(t[1]), p(t[2]));
+        let r = self.reference_of(t);
+        let d = (dot(n, n) * dot(r, r)).sqrt();
+        if d > 0.0 {
+            dot(n, r) / d
+        } else {
+            0.0
+        }
+    }
+    fn folded(&self, mesh: &TriMesh, t: [u32; 3]) -> bool {
+        self.score(t, |v| mesh.pos[v as usize]) <= MIN_COS
+    }
+    fn locked(&self, a: u32, b: u32) -> bool {
+        self.locked.contains(&(a.min(b), a.max(b)))
+    }
+}
+
+/// Untangles `mesh` in place. `reference`: a unit normal per vertex (zero for none); `fixed`:
+/// vertices that must not move (len ≥ mesh vertices); `locked`: undirected edges that must stay.
+pub fn untangle(
+    mesh: &mut TriMesh,
+    reference: &[Point3],
+    fixed: &[bool],
+    locked: &EdgeSet,
+    max_passes: usize,
+) -> UntangleStats {
+    let ctx = Ctx { reference, fixed, locked };
+    let mut stats = UntangleStats::default();
+    let mut bad: Vec<u32> = mesh.alive_faces().filter(|&f| ctx.folded(mesh, mesh.tris[f as usize])).collect();
+    stats.folded_before = bad.len();
+    for _ in 0..max_passes {
+        if bad.is_empty() {
+            break;
+        }
+        let mut progress = false;
+        for &f in &bad {
+            if !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
+                continue;
+            }
+            if try_edge_flip(mesh, &ctx, f) {
+                stats.edge_flips += 1;
+                progress = true;
+            } else if try_moves(mesh, &ctx, f) {
+                stats.vertex_moves += 1;
+                progress = true;
+            }
+        }
+        bad = mesh.alive_faces().filter(|&f| ctx.folded(mesh, mesh.tris[f as usize])).collect();
+        if !progress {
+            break;
+        }
+    }
+    stats.folded_after = bad.len();
+    stats
+}
+
+/// Flips the best non-locked edge of folded face `f` when both new faces are unfolded.
+fn try_edge_flip(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
+    let t = mesh.tris[f as usize];
+    let mut best: Option<(f64, u32, [u32; 3], [u32; 3])> = None;
+    for k in 0..3 {
+        let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        if ctx.locked(a, b) {
+            continue;
+        }
+        let Some(g) = mesh.face_with_edge(b, a) else { continue };
+        let tg = mesh.tris[g as usize];
+        let Some(&d) = tg.iter().find(|&&v| v != a && v != b) else { continue };
+        if d == c || mesh.has_edge(c, d) {
+            continue;
+        }
+        let (n1, n2) = ([c, a, d], [d, b, c]);
+        let p = |v: u32| mesh.pos[v as usize];
+        let (s1, s2) = (ctx.score(n1, p), ctx.score(n2, p));
+        if s1 <= MIN_COS || s2 <= MIN_COS {
+            continue;
+        }
+        // Prefer the flip whose worse face is the better oriented.
+        let q = s1.min(s2);
+        if best.is_none_or(|b| q > b.0) {
+            best = Some((q, g, n1, n2));
+        }
+    }
+    let Some((_, g, n1, n2)) = best else { return false };
+    mesh.remove_face(f);
+    mesh.remove_face(g);
+    let (ok1, ok2) = (mesh.add_face(n1), mesh.add_face(n2));
+    debug_assert!(ok1.is_ok() && ok2.is_ok());
+    ok1.is_ok() && ok2.is_ok()
+}
+
+/// Moves one free vertex of `f` (or of a face around `f`'s corners) to a ring mean when that
+/// unfolds every face around it and reduces the folded count.
+fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
+    let t = mesh.tris[f as usize];
+    let mut cand: Vec<u32> = t.iter().copied().filter(|&v| !ctx.fixed[v as usize]).collect();
+    for &v in &t {
+        for &g in mesh.faces_of(v) {
+            for &w in &mesh.tris[g as usize] {
+                if !ctx.fixed[w as usize] && !cand.contains(&w) {
+                    cand.push(w);
+                }
+            }
+        }
+    }
+    for v in cand {
+        if mesh.is_boundary_vertex(v) {
+            continue;
+        }
+        let star: Vec<u32> = mesh.faces_of(v).to_vec();
+        let folded_now = star.iter().filter(|&&g| ctx.folded(mesh, mesh.tris[g as usize])).count();
+        if folded_now == 0 {
+            continue;
+        }
+        let mut ring: Vec<u32> = Vec::new();
+        for &g in &star {
+            for &w in &mesh.tris[g as usize] {
+                if w != v && !ring.contains(&w) {
+                    ring.push(w);
+                }
+            }
+        }
+        let mean =
+            scale(ring.iter().fold([0.0; 3], |a, &w| add(a, mesh.pos[w as usize])), 1.0 / ring.len() as f64);
+        let p0 = mesh.pos[v as usize];
+        let n = ctx.reference[v as usize];
+        let d = sub(mean, p0);
+        let tangential = add(p0, sub(d, scale(n, dot(d, n))));
+        for target in [tangential, mean] {
+            let ok = star.iter().all(|&g| {
+                let tg = mesh.tris[g as usize];
+                ctx.score(tg, |w| if w == v { target } else { mesh.pos[w as usize] }) > MIN_COS
+            });
+            if ok {
+                mesh.pos[v as usize] = target;
+                return true;
+            }
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_free_vertex_pushed_across_its_ring_comes_back() {
+        // A fan of 6 triangles around vertex 6 in the plane z = 0; the centre is moved outside the
+        // hexagon, folding the faces on the far side. Reference normal +z everywhere.
+        let mut pos: Vec<Point3> = (0..6)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 6.0;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect();
+        pos.push([1.6, 0.2, 0.0]);
+        let tris: Vec<[u32; 3]> = (0..6).map(|k| [k, (k + 1) % 6, 6]).collect();
+        let mut mesh = TriMesh::new(pos, tris).unwrap();
+        let reference = vec![[0.0, 0.0, 1.0]; 7];
+        let fixed = vec![true, true, true, true, true, true, false];
+        let s = untangle(&mut mesh, &reference, &fixed, &EdgeSet::default(), 5);
+        assert!(s.folded_before > 0);
+        assert_eq!(s.folded_after, 0);
+        // The boundary ring did not move.
+        assert_eq!(mesh.pos[0], [1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_fold_between_fixed_vertices_is_flipped_away() {
+        // Faces (0,1,2) and (0,2,3) share edge 0-2; vertex 3 = (1, -0.3) lies on the same side of
+        // 0→2 as vertex 1, so (0,2,3) is clockwise (folded). All vertices fixed: only flipping
+        // 0-2 into 1-3 helps, giving (3,0,1) and (1,2,3), both counter-clockwise (by hand:
+        // cross products 0.7 and 0.7).
+        let pos = vec![[0.0, 0.0, 0.0], [1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, -0.3, 0.0]];
+        let tris = vec![[0, 1, 2], [0, 2, 3]];
+        let mut mesh = TriMesh::new(pos, tris).unwrap();
+        let reference = vec![[0.0, 0.0, 1.0]; 4];
+        let s = untangle(&mut mesh, &reference, &[true; 4], &EdgeSet::default(), 5);
+        assert_eq!((s.folded_before, s.edge_flips, s.folded_after), (1, 1, 0));
+        assert!(mesh.has_edge(1, 3) && !mesh.has_edge(0, 2));
+        // The same fold with edge 0-2 locked (a curve edge) cannot be fixed, and says so.
+        let tris = vec![[0, 1, 2], [0, 2, 3]];
+        let pos = vec![[0.0, 0.0, 0.0], [1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, -0.3, 0.0]];
+        let mut mesh = TriMesh::new(pos, tris).unwrap();
+        let mut locked = EdgeSet::default();
+        locked.insert((0, 2));
+        let s = untangle(&mut mesh, &reference, &[true; 4], &locked, 5);
+        assert_eq!((s.folded_before, s.edge_flips, s.folded_after), (1, 0, 1));
+    }
+}
