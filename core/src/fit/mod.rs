@@ -20,6 +20,7 @@ pub mod cleanup;
 pub mod compact;
 pub mod correspond;
 pub mod curves;
+pub mod ends;
 pub mod flips;
 pub mod groups;
 pub mod insert;
@@ -108,6 +109,10 @@ pub struct FitParams {
     /// A curve vertex farther than this × the template's bounding-box diagonal from every template
     /// vertex (after alignment) is an error.
     pub max_curve_distance: f64,
+    /// A curve end (a curve vertex joined to one other) within this × the template's bounding-box
+    /// diagonal of an open template's boundary is matched on the boundary, so the curve cuts
+    /// through to the rim (0 disables). Used by `matching = "insert"`.
+    pub end_snap: f64,
     /// Cap on detect-flips / subdivide / re-fit rounds.
     pub max_flip_iterations: u32,
     /// Levels of the approach to the curves before the exact fine fit (RBFs through ¼, 1/16,
@@ -142,6 +147,7 @@ impl Default for FitParams {
             coplanar_centres: CoplanarCentres::Reject,
             join_tolerance: 1e-6,
             max_curve_distance: 0.25,
+            end_snap: 0.05,
             max_flip_iterations: 4,
             approach_levels: 3,
             snap_fraction: 0.3,
@@ -164,6 +170,9 @@ impl FitParams {
         }
         if !(self.max_curve_distance.is_finite() && self.max_curve_distance > 0.0) {
             return bad("max_curve_distance", "must be > 0");
+        }
+        if !(self.end_snap.is_finite() && (0.0..=0.5).contains(&self.end_snap)) {
+            return bad("end_snap", "must be in [0, 0.5]");
         }
         if !(self.snap_fraction.is_finite() && (0.0..=0.5).contains(&self.snap_fraction)) {
             return bad("snap_fraction", "must be in [0, 0.5]");
@@ -809,7 +818,8 @@ fn fine_fit_inserted(
     };
     let before = tris.clone();
     let nv0 = pos.len();
-    let ins = insert::insert_curve_points(pos, tris, net, &pair_fixed, progress)?;
+    let ins =
+        insert::insert_curve_points(pos, tris, net, &pair_fixed, params.end_snap * template_diag, progress)?;
     for c in &ins.created_in[nv0..] {
         let (f, l) = c.ok_or_else(|| Error::Internal("inserted vertex without origin".into()))?;
         let t = before[f as usize];
