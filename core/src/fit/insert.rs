@@ -47,6 +47,8 @@ pub struct InsertStats {
     pub face_splits: usize,
     /// Feet moved off an already claimed vertex.
     pub nudged: usize,
+    /// Curve ends (network degree 1) matched on the template boundary (see [`super::ends`]).
+    pub ends_on_boundary: usize,
     /// Distance from each curve vertex to its template vertex before the fine deformation.
     pub distance_max: f64,
     pub distance_mean: f64,
@@ -61,12 +63,14 @@ pub struct Inserted {
 }
 
 /// Inserts every curve vertex not fixed by a user pair. `fixed` = (curve point, template vertex).
-/// On return `pos`/`tris` are the refined template.
+/// Curve ends within `end_snap` (a distance) of the template boundary are inserted on the
+/// boundary. On return `pos`/`tris` are the refined template.
 pub fn insert_curve_points(
     pos: &mut Vec<Point3>,
     tris: &mut Vec<[u32; 3]>,
     net: &CurveNetwork,
     fixed: &[(u32, u32)],
+    end_snap: f64,
     progress: &Progress,
 ) -> Result<Inserted> {
     let n = net.points.len();
@@ -78,7 +82,11 @@ pub fn insert_curve_points(
         }
     }
     let all: Vec<u32> = (0..n as u32).collect();
-    let feet = feet(pos, tris, &vf, &net.points, &all)?;
+    let mut feet = feet(pos, tris, &vf, &net.points, &all)?;
+    let on_rim = super::ends::boundary_feet(pos, tris, net, end_snap);
+    for b in &on_rim {
+        feet[b.point_index as usize] = (b.face, b.foot, b.distance);
+    }
     let mut vop = vec![u32::MAX; n];
     let mut claimed = vec![false; nv0];
     for &(p, v) in fixed {
@@ -123,7 +131,7 @@ pub fn insert_curve_points(
     let mut kids: Vec<Vec<u32>> = (0..mesh.tris.len() as u32).map(|f| vec![f]).collect();
     let mut origin: Vec<u32> = (0..mesh.tris.len() as u32).collect();
     let mut created_in: Vec<Option<(u32, [f64; 3])>> = vec![None; nv0];
-    let mut stats = InsertStats::default();
+    let mut stats = InsertStats { ends_on_boundary: on_rim.len(), ..Default::default() };
 
     for (k, &p) in order.iter().enumerate() {
         if k % 1024 == 0 {
@@ -349,7 +357,7 @@ mod tests {
         let mesh =
             crate::mesh::Mesh { positions: pts.clone(), curves: vec![vec![0, 1, 2]], ..Default::default() };
         let net = CurveNetwork::from_mesh(&mesh, 1e-9).unwrap();
-        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], &Progress::new()).unwrap();
+        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, &Progress::new()).unwrap();
         assert_eq!(ins.stats.face_splits, 1);
         assert_eq!(ins.stats.edge_splits, 1);
         assert_eq!(ins.stats.reused_vertices, 1);

@@ -1,0 +1,155 @@
+//! Fit sweep over every shared mesh a template can be made of: each mesh (repaired, scaled into
+//! the unit box) is cut by plane sections, the sections are moved by a known bend
+//! (`testdata::bend`), and the mesh split once is fitted to them, with 12 user pairs and with the
+//! automatic alignment. Prints per case: flips, segments as edges, regions found vs the regions
+//! the planes cut the surface into (counted independently on a finer copy), the max distance of the
+//! output to the bent surface and the time. A check of the general case, not a benchmark.
+//!
+//! Run from the repository root:
+//! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example sweep_fit [NAME…]`
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use meshwork_core::fit::testdata::{
+    bend, boundary_vertices, crossing_pairs, plane_sections, section_regions, thin_network,
+};
+use meshwork_core::fit::{run, CoplanarCentres, FitParams};
+use meshwork_core::geometry::Aabb;
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::repair::{self, RepairParams};
+use meshwork_core::shapes::subdivide_midpoint;
+use meshwork_core::spatial::Bvh;
+use meshwork_core::Progress;
+
+const MESHES: [&str; 7] = ["homer", "fandisk", "spot", "stanford-bunny", "rocker-arm", "alligator", "woody"];
+
+/// Reads, repairs (weld, orient, manifold) and scales `name` so its longest side is 1, min corner at 0.
+fn load(name: &str) -> Option<Mesh> {
+    let bytes = std::fs::read(format!("../shared/meshes/{name}.obj")).ok()?;
+    let raw = read(&bytes, &ReadOptions::default()).ok()?.mesh;
+    let params = RepairParams { fill_holes: false, ..Default::default() };
+    let mut m = repair::run(raw, &params, &Progress::new()).ok()?.meshes.remove(0);
+    let bb = Aabb::of(&m.positions)?;
+    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] = (p[k] - bb.min[k]) / side;
+        }
+    }
+    Some(m)
+}
+
+/// Four sections across the longest axis and one along each other axis, at offsets chosen off
+/// round fractions so no plane passes through a vertex of the (scaled) mesh by accident.
+fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
+    let bb = Aabb::of(&m.positions).expect("mesh has vertices");
+    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
+    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap_or(1);
+    let axis = |k: usize| {
+        let mut n = [0.0; 3];
+        n[k] = 1.0;
+        n
+    };
+    let mut p: Vec<(Point3, f64)> =
+        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
+    for k in (0..3).filter(|&k| k != long) {
+        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
+    }
+    p
+}
+
+/// Max distance of `out`'s vertices to the bent truth surface (exact closest points, BVH),
+/// relative to the truth's bbox diagonal.
+fn max_deviation(out: &Mesh, truth: &Mesh) -> f64 {
+    let bvh = Bvh::new(&truth.positions, &truth.faces);
+    let diag = Aabb::of(&truth.positions).map_or(1.0, |b| b.diagonal());
+    bvh.max_distance(&out.positions) / diag
+}
+
+/// Curve ends (curve-graph degree 1) of the output that are not on the mesh boundary: each one
+/// is a cut that stops short, so the regions on both sides stay joined. (0 on closed templates.)
+fn ends_inside(out: &Mesh) -> (usize, usize) {
+    let mut deg: HashMap<u32, usize> = HashMap::new();
+    for c in &out.curves {
+        for w in c.windows(2) {
+            if w[0] != w[1] {
+                *deg.entry(w[0]).or_default() += 1;
+                *deg.entry(w[1]).or_default() += 1;
+            }
+        }
+    }
+    let on_boundary = boundary_vertices(out);
+    let ends: Vec<u32> = deg.iter().filter(|(_, &d)| d == 1).map(|(&v, _)| v).collect();
+    (ends.iter().filter(|&&v| !on_boundary[v as usize]).count(), ends.len())
+}
+
+fn main() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let only: Vec<String> = std::env::args().skip(1).collect();
+    println!(
+        "{:<16} {:<6} {:>6} {:>6} {:>7} {:>6} {:>8} {:>9} {:>9} {:>9} {:>8}",
+        "mesh",
+        "align",
+        "tmplV",
+        "curveV",
+        "time s",
+        "flips",
+        "edges %",
+        "regions",
+        "max dev",
+        "minang",
+        "ends in"
+    );
+    for name in MESHES.iter().filter(|n| only.is_empty() || only.iter().any(|o| o == *n)) {
+        let Some(m) = load(name) else {
+            println!("{name:<16} SKIP (not readable or not repairable)");
+            continue;
+        };
+        let planes = planes(&m);
+        let expected = section_regions(&m, &planes);
+        let sections = thin_network(&plane_sections(&m, &planes), 2);
+        let template = subdivide_midpoint(&m, 1);
+        let mut truth = template.clone();
+        for p in &mut truth.positions {
+            *p = bend(*p, 1.0);
+        }
+        let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
+        let mut curves = sections;
+        for p in &mut curves.positions {
+            *p = bend(*p, 1.0);
+        }
+        for (label, pairs) in [("pairs", pairs), ("auto", Vec::new())] {
+            // Flat meshes (woody, alligator) give coplanar curves: the seed's normal augmentation.
+            let flat = Aabb::of(&m.positions).is_some_and(|b| (0..3).any(|k| b.max[k] - b.min[k] < 0.05));
+            let coplanar_centres = if flat { CoplanarCentres::Augment } else { CoplanarCentres::Reject };
+            let params = FitParams { pairs, coplanar_centres, ..Default::default() };
+            let t = Instant::now();
+            let got = run(vec![template.clone(), curves.clone()], &params, &Progress::new());
+            let secs = t.elapsed().as_secs_f64();
+            match got {
+                Err(e) => println!("{name:<16} {label:<6} ERROR {e}"),
+                Ok(out) => {
+                    let r = &out.report;
+                    let inside = ends_inside(&out.meshes[0]);
+                    println!(
+                        "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>8.2} {:>4}/{:<4} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
+                        template.positions.len(),
+                        curves.positions.len(),
+                        secs,
+                        r["flipped_faces"],
+                        100.0 * r["segments_as_edges"].as_f64().unwrap_or(f64::NAN),
+                        r["regions"],
+                        expected,
+                        max_deviation(&out.meshes[0], &truth),
+                        r["min_angle_deg_before_smoothing"].as_f64().unwrap_or(f64::NAN),
+                        r["min_angle_deg_after_smoothing"].as_f64().unwrap_or(f64::NAN),
+                        inside.0,
+                        inside.1,
+                    );
+                }
+            }
+        }
+    }
+}
