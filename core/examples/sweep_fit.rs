@@ -11,13 +11,15 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
-use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
+use meshwork_core::fit::testdata::{
+    bend, boundary_vertices, crossing_pairs, plane_sections, section_regions, thin_network,
+};
 use meshwork_core::fit::{run, CoplanarCentres, FitParams};
-use meshwork_core::geometry::{dot, Aabb};
+use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::repair::{self, RepairParams};
-use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
+use meshwork_core::shapes::subdivide_midpoint;
 use meshwork_core::spatial::Bvh;
 use meshwork_core::Progress;
 
@@ -58,53 +60,6 @@ fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
     p
 }
 
-/// Regions of the surface minus the planes, on a 4×-subdivided copy: faces grouped by the side
-/// of every plane, connected through shared edges; faces cut by a plane are left out.
-fn expected_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
-    let fine = subdivide_midpoint(m, 2);
-    let tris = fan_triangles(&fine.faces);
-    let side = |p: Point3| {
-        planes.iter().enumerate().fold(0u32, |c, (k, (n, o))| c | (((dot(*n, p) - o) > 0.0) as u32) << k)
-    };
-    let code: Vec<Option<u32>> = tris
-        .iter()
-        .map(|t| {
-            let c: Vec<u32> = t.iter().map(|&v| side(fine.positions[v as usize])).collect();
-            (c[0] == c[1] && c[1] == c[2]).then_some(c[0])
-        })
-        .collect();
-    let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edge.entry((a.min(b), a.max(b))).or_default().push(f);
-        }
-    }
-    let mut seen = vec![false; tris.len()];
-    let mut count = 0;
-    for s in 0..tris.len() {
-        if seen[s] || code[s].is_none() {
-            continue;
-        }
-        count += 1;
-        let mut stack = vec![s];
-        seen[s] = true;
-        while let Some(f) = stack.pop() {
-            let t = tris[f];
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                for &g in &edge[&(a.min(b), a.max(b))] {
-                    if !seen[g] && code[g] == code[f] {
-                        seen[g] = true;
-                        stack.push(g);
-                    }
-                }
-            }
-        }
-    }
-    count
-}
-
 /// Max distance of `out`'s vertices to the bent truth surface (exact closest points, BVH),
 /// relative to the truth's bbox diagonal.
 fn max_deviation(out: &Mesh, truth: &Mesh) -> f64 {
@@ -125,20 +80,7 @@ fn ends_inside(out: &Mesh) -> (usize, usize) {
             }
         }
     }
-    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
-    for f in out.faces.iter() {
-        for k in 0..f.len() {
-            let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut on_boundary = vec![false; out.positions.len()];
-    for (&(a, b), &n) in &uses {
-        if n == 1 {
-            on_boundary[a as usize] = true;
-            on_boundary[b as usize] = true;
-        }
-    }
+    let on_boundary = boundary_vertices(out);
     let ends: Vec<u32> = deg.iter().filter(|(_, &d)| d == 1).map(|(&v, _)| v).collect();
     (ends.iter().filter(|&&v| !on_boundary[v as usize]).count(), ends.len())
 }
@@ -166,7 +108,7 @@ fn main() {
             continue;
         };
         let planes = planes(&m);
-        let expected = expected_regions(&m, &planes);
+        let expected = section_regions(&m, &planes);
         let sections = thin_network(&plane_sections(&m, &planes), 2);
         let template = subdivide_midpoint(&m, 1);
         let mut truth = template.clone();

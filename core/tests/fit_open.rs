@@ -5,8 +5,7 @@
 //! x = 0.7 and y = 0.5 (rim to rim) moved by a known map that shrinks the square by 5 % and lifts
 //! it into a bump. Three lines rim to rim cut the square into 3 × 2 = 6 regions.
 
-use std::collections::HashMap;
-
+use meshwork_core::fit::testdata::boundary_vertices;
 use meshwork_core::fit::{run, Alignment, CoplanarCentres, FitParams};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::grid;
@@ -28,25 +27,6 @@ fn curves() -> Mesh {
     line(&|t| [0.7, t, 0.0]);
     line(&|t| [t, 0.5, 0.0]);
     m
-}
-
-/// Vertices on the output's boundary (edges used by one face).
-fn boundary_vertices(m: &Mesh) -> Vec<bool> {
-    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
-    for f in m.faces.iter() {
-        for k in 0..f.len() {
-            let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut on = vec![false; m.positions.len()];
-    for (&(a, b), &n) in &uses {
-        if n == 1 {
-            on[a as usize] = true;
-            on[b as usize] = true;
-        }
-    }
-    on
 }
 
 fn fit(end_snap: f64) -> (serde_json::Value, Mesh) {

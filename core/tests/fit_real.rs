@@ -3,11 +3,9 @@
 //! surface (distance of the fit to it), and the number of regions the planes cut the surface into
 //! (counted independently on a finer copy of the original).
 
-use std::collections::HashMap;
-
 use meshwork_core::fit::kdtree::KdTree;
 use meshwork_core::fit::smooth::closest_on_triangle;
-use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
+use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, section_regions, thin_network};
 use meshwork_core::fit::{run, FitParams};
 use meshwork_core::geometry::{dist, dot, triangle_cross, Aabb};
 use meshwork_core::io::{read, ReadOptions};
@@ -31,62 +29,6 @@ fn planes() -> Vec<(Point3, f64)> {
     p
 }
 
-/// Regions of the surface minus the planes: faces of a 4×-subdivided copy grouped by the side of
-/// every plane, connected through shared edges; faces cut by a plane are left out.
-fn expected_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
-    let fine = subdivide_midpoint(m, 2);
-    let tris = fan_triangles(&fine.faces);
-    let side = |p: Point3| -> Option<u32> {
-        let mut code = 0;
-        for (k, (n, o)) in planes.iter().enumerate() {
-            let s = dot(*n, p) - o;
-            code |= ((s > 0.0) as u32) << k;
-        }
-        Some(code)
-    };
-    let code: Vec<Option<u32>> = tris
-        .iter()
-        .map(|t| {
-            let c: Vec<Option<u32>> = t.iter().map(|&v| side(fine.positions[v as usize])).collect();
-            if c[0] == c[1] && c[1] == c[2] {
-                c[0]
-            } else {
-                None
-            }
-        })
-        .collect();
-    let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edge.entry((a.min(b), a.max(b))).or_default().push(f);
-        }
-    }
-    let mut seen = vec![false; tris.len()];
-    let mut count = 0;
-    for s in 0..tris.len() {
-        if seen[s] || code[s].is_none() {
-            continue;
-        }
-        count += 1;
-        let mut stack = vec![s];
-        seen[s] = true;
-        while let Some(f) = stack.pop() {
-            let t = tris[f];
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                for &g in &edge[&(a.min(b), a.max(b))] {
-                    if !seen[g] && code[g] == code[f] {
-                        seen[g] = true;
-                        stack.push(g);
-                    }
-                }
-            }
-        }
-    }
-    count
-}
-
 #[test]
 fn homer_fits_sections_of_its_bent_self() {
     let original = homer();
@@ -103,7 +45,7 @@ fn homer_fits_sections_of_its_bent_self() {
     }
     let truth_pos: Vec<Point3> = template.positions.iter().map(|&p| bend(p, 1.0)).collect();
     let truth_tris = fan_triangles(&template.faces);
-    let expected = expected_regions(&original, &planes);
+    let expected = section_regions(&original, &planes);
 
     let params = FitParams { pairs, ..Default::default() };
     let out = run(vec![template.clone(), curves], &params, &Progress::new()).expect("fit");

@@ -16,6 +16,8 @@
 
 pub mod align;
 pub mod approach;
+pub mod cleanup;
+pub mod compact;
 pub mod correspond;
 pub mod curves;
 pub mod ends;
@@ -31,6 +33,7 @@ pub mod smooth;
 pub mod testdata;
 pub mod trimesh;
 pub mod untangle;
+pub mod uvs;
 
 use serde::{Deserialize, Serialize};
 
@@ -118,6 +121,10 @@ pub struct FitParams {
     /// A segment crossing an edge within this fraction of its length from a vertex snaps the
     /// vertex onto the segment (0 disables; at most 0.5).
     pub snap_fraction: f64,
+    /// Run the sliver clean-up after re-triangulation (edge flips, then collapses of free vertices).
+    pub cleanup: bool,
+    /// Faces whose smallest angle is below this (degrees) are treated by the clean-up.
+    pub cleanup_min_angle_deg: f64,
     /// Run the smoothing stage.
     pub smooth: bool,
     /// Iterations of the modified mean-curvature flow.
@@ -144,6 +151,8 @@ impl Default for FitParams {
             max_flip_iterations: 4,
             approach_levels: 3,
             snap_fraction: 0.3,
+            cleanup: true,
+            cleanup_min_angle_deg: 15.0,
             smooth: true,
             mcf_iterations: 10,
             mcf_step: 0.5,
@@ -170,6 +179,9 @@ impl FitParams {
         }
         if !(self.mcf_step.is_finite() && self.mcf_step > 0.0 && self.mcf_step <= 1.0) {
             return bad("mcf_step", "must be in (0, 1]");
+        }
+        if !(self.cleanup_min_angle_deg.is_finite() && (0.0..=50.0).contains(&self.cleanup_min_angle_deg)) {
+            return bad("cleanup_min_angle_deg", "must be in [0, 50]");
         }
         if self.approach_levels > 6 {
             return bad("approach_levels", "must be ≤ 6");
@@ -296,21 +308,80 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         // (Boundary vertices are never moved by the untangling either.)
         Ok(untangle::untangle(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
     })?;
+    let retri_tris = mesh.live_triangles();
+    let angles_retri = report::angle_stats(&mesh.pos, &retri_tris);
+    let (region0, mut region_count) =
+        stages.run(progress, "partition", || Ok(partition::regions(&retri_tris, &curve_edges)))?;
+    // Label of every face id: region × template group, kept by the clean-up.
+    let group0 = if keep_groups {
+        groups::after_retriangulation(&fine_tris, &fine_groups, &retri_tris, mesh.pos.len())
+    } else {
+        vec![0; retri_tris.len()]
+    };
+    let mut labels = vec![u64::MAX; mesh.tris.len()];
+    for ((f, &r), &g) in mesh.alive_faces().collect::<Vec<_>>().into_iter().zip(&region0).zip(&group0) {
+        labels[f as usize] = ((r as u64) << 32) | g as u64;
+    }
+    drop(retri_tris);
+    let boundary: Vec<bool> = (0..mesh.pos.len() as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
+    let fixed: Vec<bool> = (0..mesh.pos.len()).map(|v| realised.on_curve[v] || boundary[v]).collect();
+    let cleaned = stages.run(progress, "cleanup", || {
+        if !params.cleanup {
+            return Ok(cleanup::CleanupStats::default());
+        }
+        let mut curve_point = vec![false; mesh.pos.len()];
+        for &v in &fine.vertex_of_point {
+            curve_point[v as usize] = true;
+        }
+        let mut c = cleanup::Constraints {
+            fixed: &fixed,
+            locked: curve_edges.clone(),
+            chain: cleanup::Constraints::chain_vertices(&realised.chains, &curve_point, &boundary),
+            reference_normals: &reference_normals,
+        };
+        let s = cleanup::CleanupSettings { min_angle_deg: params.cleanup_min_angle_deg, max_passes: 8 };
+        cleanup::clean(&mut mesh, &mut labels, &mut c, &s, progress)
+    })?;
+    // Vertices the clean-up removed stay in the arrays (faceless) until the output is built.
+    let mut realised = realised;
+    if !cleaned.removed_vertices.is_empty() {
+        // Chain vertices the clean-up removed leave their chains (their neighbours are joined).
+        let mut gone = vec![false; mesh.pos.len()];
+        for &v in &cleaned.removed_vertices {
+            gone[v as usize] = true;
+        }
+        for c in realised.chains.iter_mut() {
+            c.retain(|&v| !gone[v as usize]);
+        }
+        curve_edges.clear();
+        for c in &realised.chains {
+            for p in c.windows(2) {
+                curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
+            }
+        }
+    }
     let mut out_tris = mesh.live_triangles();
-    let (mut region, mut region_count) =
-        stages.run(progress, "partition", || Ok(partition::regions(&out_tris, &curve_edges)))?;
+    let mut region: Vec<u32> = mesh.alive_faces().map(|f| (labels[f as usize] >> 32) as u32).collect();
+    // Template groups of the faces the clean-up made: the rule used for re-triangulated faces
+    // (the clean-up never edits across a group border, but a face re-triangulation made across
+    // one carries a majority label that is not the geometric truth for its pieces).
+    let mut tg: Vec<u32> = if keep_groups && cleaned.flips + cleaned.collapses > 0 {
+        groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, mesh.pos.len())
+    } else {
+        mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
+    };
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
     let mut out_pos = mesh.pos.clone();
+    let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
-        let fixed: Vec<bool> = (0..out_pos.len() as u32)
-            .map(|v| realised.on_curve[v as usize] || mesh.is_boundary_vertex(v))
-            .collect();
         let settings = smooth::SmoothSettings {
             mcf_iterations: params.mcf_iterations,
             mcf_step: params.mcf_step,
             laplacian_iterations: params.laplacian_iterations,
+            // Smoothing does not make a face the clean-up accepts into one it would treat.
+            min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
-        stages.run(progress, "smooth", || {
+        smoothing = stages.run(progress, "smooth", || {
             smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
         })?;
     }
@@ -327,6 +398,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             // recomputed for the new face list.
             out_tris = mesh.live_triangles();
             (region, region_count) = partition::regions(&out_tris, &curve_edges);
+            if keep_groups {
+                tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
+            }
         }
         Some(s)
     } else {
@@ -334,12 +408,23 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     };
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
+    // Vertices removed by the clean-up leave the output; every per-vertex array is renumbered.
+    let keep = compact::Renumber::new(out_pos.len(), &cleaned.removed_vertices);
+    let out_tris: Vec<[u32; 3]> = out_tris.iter().map(|&t| keep.tri(t)).collect();
+    for c in realised.chains.iter_mut() {
+        keep.apply(c);
+    }
+    let mut vertex_of_point = fine.vertex_of_point.clone();
+    keep.apply(&mut vertex_of_point);
+    let reference_normals = keep.vec(&reference_normals);
+    let fine_positions = keep.vec(&fine_positions);
+    let out_pos = keep.vec(&out_pos);
+
     // Output mesh: one group per region (per region × template group when the template had
     // groups), the curves as vertex chains.
     let mut faces = Faces::with_capacity(out_tris.len(), out_tris.len() * 3);
     let mut group_names: Vec<String> = (0..region_count).map(|i| format!("region_{i}")).collect();
     if keep_groups {
-        let tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
         let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
         group_names.clear();
         for ((t, &r), &g) in out_tris.iter().zip(&region).zip(&tg) {
@@ -355,7 +440,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         }
     }
     let mut out = Mesh::new(out_pos, faces);
-    out.uvs = template.uvs.as_ref().map(|uv| interpolate_uvs(uv, &parents));
+    out.uvs = template.uvs.as_ref().map(|uv| {
+        let mut uvs = interpolate_uvs(uv, &parents);
+        uvs::apply(&mut uvs, &realised.uv_moves);
+        keep.vec(&uvs)
+    });
     out.groups = group_names;
     out.curves = report::polyline_chains(&net, &realised.chains);
 
@@ -363,7 +452,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         Ok(report::Quality::measure(
             &out,
             &net,
-            &fine.vertex_of_point,
+            &vertex_of_point,
             &realised,
             &out_tris,
             &fine_positions,
@@ -394,6 +483,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "segments_as_edges": quality.segments_as_edges,
         "flipped_faces": quality.flipped_faces,
         "flipped_faces_after_fine": fine.report.flipped_faces,
+        "cleanup": cleaned,
+        "moved_vertices": realised.uv_moves.iter().map(|m| m.vertex).collect::<Vec<_>>(),
+        "smoothing": smoothing,
+        "min_angle_deg_after_retriangulation": angles_retri.min_deg,
+        "mean_min_angle_deg_after_retriangulation": angles_retri.mean_min_deg,
+        "faces_below_10deg_after_retriangulation": angles_retri.below_10,
         "min_angle_deg_before_smoothing": angles_before.min_deg,
         "min_angle_deg_after_smoothing": angles_after.min_deg,
         "mean_min_angle_deg_before_smoothing": angles_before.mean_min_deg,

@@ -75,6 +75,9 @@ pub struct Realised {
     /// Vertices on some chain (curve vertices and those added to chains).
     pub on_curve: Vec<bool>,
     pub stats: RetriStats,
+    /// Vertices moved over the surface (snapped or pulled onto a segment), in move order, with
+    /// where their new position lies on the mesh before the move: their UVs follow ([`super::uvs`]).
+    pub uv_moves: Vec<super::uvs::UvMove>,
 }
 
 impl RetriStats {
@@ -151,6 +154,7 @@ pub fn realise(
     let mut locked_edges = EdgeSet::default();
     let mut stats = RetriStats { segments: net.segments.len(), ..Default::default() };
     let mut chains = Vec::with_capacity(net.segments.len());
+    let mut uv_moves = Vec::new();
     for (si, seg) in net.segments.iter().enumerate() {
         if si % 256 == 0 {
             progress.fraction(si as f64 / net.segments.len().max(1) as f64)?;
@@ -162,14 +166,23 @@ pub fn realise(
             chain.push(w);
         } else {
             let before = stats.clone_counts();
-            let ok =
-                walk_segment(mesh, u, w, snap_fraction, &mut on_curve, &locked_edges, &mut chain, &mut stats);
+            let ok = walk_segment(
+                mesh,
+                u,
+                w,
+                snap_fraction,
+                &mut on_curve,
+                &locked_edges,
+                &mut chain,
+                &mut stats,
+                &mut uv_moves,
+            );
             if ok {
                 stats.walked += 1;
             } else {
                 // Fallback from wherever the walk stopped.
                 let from = *chain.last().unwrap_or(&u);
-                match dijkstra_project(mesh, from, w, &on_curve) {
+                match dijkstra_project(mesh, from, w, &on_curve, &mut uv_moves) {
                     Some(path) => {
                         stats.fallback_segments += 1;
                         stats.fallback_moved_vertices += path.len().saturating_sub(2);
@@ -200,7 +213,7 @@ pub fn realise(
         }
         chains.push(chain);
     }
-    Ok(Realised { chains, on_curve, stats })
+    Ok(Realised { chains, on_curve, stats, uv_moves })
 }
 
 /// Walks and re-triangulates from u to w, possibly in pieces at snapped vertices. Pushes chain
@@ -215,6 +228,7 @@ fn walk_segment(
     locked_edges: &EdgeSet,
     chain: &mut Vec<u32>,
     stats: &mut RetriStats,
+    uv_moves: &mut Vec<super::uvs::UvMove>,
 ) -> bool {
     let (a, b) = (mesh.pos[u as usize], mesh.pos[w as usize]);
     let d = sub(b, a);
@@ -239,7 +253,9 @@ fn walk_segment(
                 return true;
             }
             Walk::SnapAtStart(z) => {
-                mesh.pos[z as usize] = cut.on_line(mesh.pos[z as usize]);
+                let target = cut.on_line(mesh.pos[z as usize]);
+                uv_moves.extend(super::uvs::record(mesh, z, target));
+                mesh.pos[z as usize] = target;
                 on_curve[z as usize] = true;
                 stats.snapped_vertices += 1;
                 chain.push(z);
@@ -247,14 +263,18 @@ fn walk_segment(
             }
             Walk::Strip { faces, crossed, end } => {
                 let old = mesh.pos[end as usize];
+                let mut moved = None;
                 if end != w {
-                    mesh.pos[end as usize] = cut.on_line(old);
+                    let target = cut.on_line(old);
+                    moved = super::uvs::record(mesh, end, target);
+                    mesh.pos[end as usize] = target;
                 }
                 if !retriangulate(mesh, cur, end, &faces, &crossed) {
                     mesh.pos[end as usize] = old;
                     stats.walk_fail_fill += 1;
                     return false;
                 }
+                uv_moves.extend(moved);
                 chain.push(end);
                 if end == w {
                     return true;
@@ -523,7 +543,13 @@ fn ear_cut(mesh: &TriMesh, poly: &[u32], origin: Point3, e1: Point3, e2: Point3)
 
 /// §3.2 fallback: shortest edge path from `from` to `to` through free vertices, whose inner
 /// vertices are then moved onto the segment (spaced by their arc length along the path).
-fn dijkstra_project(mesh: &mut TriMesh, from: u32, to: u32, on_curve: &[bool]) -> Option<Vec<u32>> {
+fn dijkstra_project(
+    mesh: &mut TriMesh,
+    from: u32,
+    to: u32,
+    on_curve: &[bool],
+    uv_moves: &mut Vec<super::uvs::UvMove>,
+) -> Option<Vec<u32>> {
     let mut dist: IntMap<u32, f64> = IntMap::default();
     let mut prev: IntMap<u32, u32> = IntMap::default();
     let mut heap = BinaryHeap::new();
@@ -570,10 +596,17 @@ fn dijkstra_project(mesh: &mut TriMesh, from: u32, to: u32, on_curve: &[bool]) -
     let (a, b) = (mesh.pos[from as usize], mesh.pos[to as usize]);
     let mut acc = 0.0;
     let old: Vec<Point3> = path.iter().map(|&v| mesh.pos[v as usize]).collect();
+    let mut targets = Vec::with_capacity(path.len());
     for k in 1..path.len().saturating_sub(1) {
         acc += crate::geometry::dist(old[k - 1], old[k]);
         let frac = if total > 0.0 { acc / total } else { 0.5 };
-        mesh.pos[path[k] as usize] = add(a, scale(sub(b, a), frac));
+        let target = add(a, scale(sub(b, a), frac));
+        // Located on the mesh before any path vertex moves.
+        uv_moves.extend(super::uvs::record(mesh, path[k], target));
+        targets.push(target);
+    }
+    for (k, target) in targets.into_iter().enumerate() {
+        mesh.pos[path[k + 1] as usize] = target;
     }
     Some(path)
 }

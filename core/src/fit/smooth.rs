@@ -9,6 +9,16 @@
 //!    step from the current position, then back-projection onto the surface *as it was before
 //!    smoothing* (closest point, found by a local walk over the reference faces, which keeps the
 //!    O(faces) per iteration of §4.3.4).
+//!
+//! Both flows are guarded ([`commit_safely`]): all free vertices move at once, then a vertex whose
+//! new star has a face turned over (against that face's normal before the step), or a face whose
+//! smallest angle got worse *and* is below the floor, has its step halved (and re-projected),
+//! and after [`MAX_HALVINGS`] halvings is left where it was (a face that fails halves the
+//! steps of all its moving corners). The floor is the larger of
+//! `min_angle_floor_deg` and the smallest angle of the mesh before smoothing: a face above it
+//! may get worse down to it, a face below it may not get worse. The checks repeat on the
+//! faces around every changed vertex until none fails, so no face is made degenerate or
+//! flipped and the smallest angle of the mesh never decreases.
 
 use rayon::prelude::*;
 
@@ -21,7 +31,23 @@ pub struct SmoothSettings {
     pub mcf_iterations: u32,
     pub mcf_step: f64,
     pub laplacian_iterations: u32,
+    /// Faces above this smallest angle (degrees) may get worse down to it, not below.
+    pub min_angle_floor_deg: f64,
 }
+
+/// What the guard did, over all iterations.
+#[derive(Debug, Clone, Copy, Default, serde::Serialize)]
+pub struct SmoothStats {
+    /// Vertex steps proposed by the flows (free vertices that wanted to move).
+    pub moves: usize,
+    /// Steps halved at least once because they flipped a face or lowered the worst angle.
+    pub moves_halved: usize,
+    /// Steps given up after [`MAX_HALVINGS`] halvings (the vertex stayed put that iteration).
+    pub moves_rejected: usize,
+}
+
+/// Halvings of a failing step before the vertex is left where it was.
+pub const MAX_HALVINGS: u32 = 3;
 
 /// Compressed vertex → neighbours and vertex → faces.
 struct Rings {
@@ -89,9 +115,12 @@ pub fn smooth(
     fixed: &[bool],
     s: &SmoothSettings,
     progress: &Progress,
-) -> Result<()> {
+) -> Result<SmoothStats> {
     let nv = pos.len();
     let r = rings(nv, tris);
+    let mut stats = SmoothStats::default();
+    let q_start = tris.par_iter().map(|&t| face_quality(pos, t)).reduce(|| f64::INFINITY, f64::min);
+    let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
     // Stage 1: modified mean-curvature flow.
     for it in 0..s.mcf_iterations {
@@ -117,7 +146,8 @@ pub fn smooth(
             }
         }
         let old = pos.to_vec();
-        pos.par_iter_mut().enumerate().for_each(|(v, p)| {
+        let mut proposed = old.clone();
+        proposed.par_iter_mut().enumerate().for_each(|(v, p)| {
             if fixed[v] || acc[v][3] <= 0.0 {
                 return;
             }
@@ -145,6 +175,8 @@ pub fn smooth(
                 None => moved,
             };
         });
+        // A halved step stays on the plane it was dropped onto (old and new are both on it).
+        commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut stats, |_, q| q);
     }
     // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
     let reference = pos.to_vec();
@@ -154,7 +186,9 @@ pub fn smooth(
     for it in 0..s.laplacian_iterations {
         progress.fraction((s.mcf_iterations + it) as f64 / total)?;
         let old = pos.to_vec();
-        pos.par_iter_mut().zip(ref_face.par_iter_mut()).enumerate().for_each(|(v, (p, rf))| {
+        let mut proposed = old.clone();
+        let mut new_ref = ref_face.clone();
+        proposed.par_iter_mut().zip(new_ref.par_iter_mut()).enumerate().for_each(|(v, (p, rf))| {
             let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
             if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
                 return;
@@ -171,8 +205,144 @@ pub fn smooth(
             *rf = f;
             *p = q;
         });
+        // A halved step is dropped back onto the reference surface like a full one.
+        let kept = commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut stats, |v, q| {
+            closest_by_walk(&reference, tris, &r, ref_face[v], q).1
+        });
+        for v in kept {
+            let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], pos[v as usize]);
+            new_ref[v as usize] = f;
+        }
+        for (v, rf) in ref_face.iter_mut().enumerate() {
+            if pos[v] == old[v] {
+                continue; // did not move: keep its face
+            }
+            *rf = new_ref[v];
+        }
     }
-    Ok(())
+    Ok(stats)
+}
+
+/// sin² of a face's smallest angle (the corner opposite the shortest edge): |n|² / (|e1|²·|e2|²)
+/// with e1, e2 the two longer edges. Monotone in the angle on [0°, 60°], where a smallest angle
+/// always is, and free of trigonometry. 0 for a degenerate face.
+pub fn min_angle_quality(a: Point3, b: Point3, c: Point3) -> f64 {
+    let (la, lb, lc) = (norm2(sub(b, c)), norm2(sub(c, a)), norm2(sub(a, b)));
+    let n = norm2(cross(sub(b, a), sub(c, a)));
+    let prod = if la <= lb && la <= lc {
+        lb * lc
+    } else if lb <= lc {
+        la * lc
+    } else {
+        la * lb
+    };
+    if prod > 0.0 {
+        n / prod
+    } else {
+        0.0
+    }
+}
+
+fn face_quality(pos: &[Point3], t: [u32; 3]) -> f64 {
+    min_angle_quality(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
+}
+
+#[allow(clippy::too_many_arguments)]
+/// Moves `pos` from `old` to `proposed` where that is safe (see the module doc); `reproject`
+/// puts a halved step back on the surface. Returns the vertices whose step was halved and kept
+/// (their reference face may need updating).
+fn commit_safely(
+    pos: &mut [Point3],
+    old: &[Point3],
+    proposed: Vec<Point3>,
+    tris: &[[u32; 3]],
+    r: &Rings,
+    q_floor: f64,
+    stats: &mut SmoothStats,
+    reproject: impl Fn(usize, Point3) -> Point3 + Sync,
+) -> Vec<u32> {
+    let nv = old.len();
+    let mut cand = proposed;
+    let moves = cand.par_iter().zip(old).filter(|(a, b)| a != b).count();
+    stats.moves += moves;
+    if moves == 0 {
+        pos.copy_from_slice(old);
+        return Vec::new();
+    }
+    // A relative margin so that the reported angle, computed differently, cannot come out lower.
+    let floor = q_floor * (1.0 + 1e-9);
+    let acceptable = |cand: &[Point3], t: [u32; 3], n_old: Point3, q_old: f64| {
+        let n = face_normal(cand, t);
+        if dot(n, n_old) <= 0.0 {
+            return false; // turned over (or degenerate)
+        }
+        let q = face_quality(cand, t);
+        q >= q_old || q >= floor
+    };
+    // One pass over the faces: the old normal and quality, and whether the step is acceptable.
+    let before: Vec<(Point3, f64, bool)> = tris
+        .par_iter()
+        .map(|&t| {
+            let (n0, q0) = (face_normal(old, t), face_quality(old, t));
+            let moved = t.iter().any(|&v| cand[v as usize] != old[v as usize]);
+            (n0, q0, !moved || acceptable(&cand, t, n0, q0))
+        })
+        .collect();
+    let mut bad: Vec<u32> = (0..tris.len() as u32).filter(|&f| !before[f as usize].2).collect();
+    let mut halvings = vec![0u8; nv];
+    let mut vmark = vec![false; nv];
+    let mut fmark = vec![false; tris.len()];
+    while !bad.is_empty() {
+        // Halve (or give up) the step of every moving corner of a failing face.
+        let mut changed: Vec<u32> = Vec::new();
+        for &f in &bad {
+            for &v in &tris[f as usize] {
+                if cand[v as usize] != old[v as usize] && !vmark[v as usize] {
+                    vmark[v as usize] = true;
+                    changed.push(v);
+                }
+            }
+        }
+        let mut faces: Vec<u32> = Vec::new();
+        for &v in &changed {
+            let v = v as usize;
+            vmark[v] = false;
+            halvings[v] += 1;
+            cand[v] = if halvings[v] as u32 > MAX_HALVINGS {
+                old[v]
+            } else {
+                reproject(v, scale(add(old[v], cand[v]), 0.5))
+            };
+            for &f in &r.vf[r.vf_off[v] as usize..r.vf_off[v + 1] as usize] {
+                if !fmark[f as usize] {
+                    fmark[f as usize] = true;
+                    faces.push(f);
+                }
+            }
+        }
+        for &f in &faces {
+            fmark[f as usize] = false;
+        }
+        // Re-check the faces around the changed vertices.
+        bad = faces
+            .into_iter()
+            .filter(|&f| {
+                let (n0, q0, _) = before[f as usize];
+                !acceptable(&cand, tris[f as usize], n0, q0)
+            })
+            .collect();
+    }
+    let mut halved = Vec::new();
+    for (v, &h) in halvings.iter().enumerate() {
+        if h as u32 > MAX_HALVINGS {
+            stats.moves_rejected += 1;
+        } else if h > 0 {
+            stats.moves_halved += 1;
+            halved.push(v as u32);
+        }
+    }
+    pos.copy_from_slice(&cand);
+    halved
 }
 
 fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
@@ -247,7 +417,12 @@ mod tests {
         let fixed: Vec<bool> = (0..pos.len()).map(|i| i % 7 == 0).collect();
         let before = pos.clone();
         let q0 = crate::fit::report::angle_stats(&pos, &tris);
-        let settings = SmoothSettings { mcf_iterations: 10, mcf_step: 0.5, laplacian_iterations: 20 };
+        let settings = SmoothSettings {
+            mcf_iterations: 10,
+            mcf_step: 0.5,
+            laplacian_iterations: 20,
+            min_angle_floor_deg: 15.0,
+        };
         smooth(&mut pos, &tris, &fixed, &settings, &Progress::new()).unwrap();
         let q1 = crate::fit::report::angle_stats(&pos, &tris);
         for (i, p) in pos.iter().enumerate() {
@@ -259,5 +434,11 @@ mod tests {
             assert!((norm(*p) - 1.0).abs() < 0.006, "vertex {i} at radius {}", norm(*p));
         }
         assert!(q1.mean_min_deg > q0.mean_min_deg, "{q0:?} → {q1:?}");
+        assert!(q1.min_deg >= q0.min_deg, "{q0:?} → {q1:?}");
+        // No face turned against the sphere's outward normal.
+        for t in &tris {
+            let c = add(add(pos[t[0] as usize], pos[t[1] as usize]), pos[t[2] as usize]);
+            assert!(dot(face_normal(&pos, *t), c) > 0.0);
+        }
     }
 }

@@ -5,6 +5,7 @@ use std::collections::HashMap;
 
 use crate::geometry::{add, dot, scale, sub};
 use crate::mesh::{Mesh, Point3};
+use crate::shapes::{fan_triangles, subdivide_midpoint};
 
 /// The three principal-plane sections of the ellipsoid x²/a² + y²/b² + z²/c² = 1, each sampled at
 /// `per_quadrant` points per quarter so that the six axis points are shared: 6 feature points of
@@ -212,4 +213,71 @@ pub fn crossing_pairs(
             Some(super::FitPair { template_vertex: v, curve_point: map(p) })
         })
         .collect()
+}
+
+/// Regions a set of planes cuts a surface into (the truth for section networks), counted on a
+/// 4×-subdivided copy: faces grouped by the side
+/// of every plane, connected through shared edges; faces cut by a plane are left out.
+pub fn section_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
+    let fine = subdivide_midpoint(m, 2);
+    let tris = fan_triangles(&fine.faces);
+    let side = |p: Point3| {
+        planes.iter().enumerate().fold(0u32, |c, (k, (n, o))| c | (((dot(*n, p) - o) > 0.0) as u32) << k)
+    };
+    let code: Vec<Option<u32>> = tris
+        .iter()
+        .map(|t| {
+            let c: Vec<u32> = t.iter().map(|&v| side(fine.positions[v as usize])).collect();
+            (c[0] == c[1] && c[1] == c[2]).then_some(c[0])
+        })
+        .collect();
+    let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let mut seen = vec![false; tris.len()];
+    let mut count = 0;
+    for s in 0..tris.len() {
+        if seen[s] || code[s].is_none() {
+            continue;
+        }
+        count += 1;
+        let mut stack = vec![s];
+        seen[s] = true;
+        while let Some(f) = stack.pop() {
+            let t = tris[f];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for &g in &edge[&(a.min(b), a.max(b))] {
+                    if !seen[g] && code[g] == code[f] {
+                        seen[g] = true;
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+    }
+    count
+}
+
+/// Vertices on the boundary of `m` (on an edge used by one face).
+pub fn boundary_vertices(m: &Mesh) -> Vec<bool> {
+    let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
+    for f in m.faces.iter() {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut on = vec![false; m.positions.len()];
+    for (&(a, b), &n) in &uses {
+        if n == 1 {
+            on[a as usize] = true;
+            on[b as usize] = true;
+        }
+    }
+    on
 }
