@@ -146,6 +146,34 @@ fn rotated_mirrored(m: &Mesh) -> Mesh {
     })
 }
 
+/// Rotation about (1,2,3) by 0.7 rad, scale 3.5, moved: the same shape, so after the PCA
+/// normalisation the morph should not move at all (if the axis sign rule is deterministic).
+fn rotated_scaled(m: &Mesh) -> Mesh {
+    let k = normalize([1.0, 2.0, 3.0]);
+    let (s, c) = 0.7f64.sin_cos();
+    map(m, |p| {
+        let kxp = [k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0]];
+        let kdp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
+        let r: Vec<f64> = (0..3).map(|i| p[i] * c + kxp[i] * s + k[i] * kdp * (1.0 - c)).collect();
+        [3.5 * r[0] + 10.0, 3.5 * r[1], 3.5 * r[2] - 4.0]
+    })
+}
+
+/// Largest distance a metamesh vertex travels between the first two output meshes (same
+/// connectivity), over the first's bbox diagonal.
+fn motion(a: &Mesh, b: &Mesh) -> f64 {
+    if a.positions.len() != b.positions.len() {
+        return f64::NAN;
+    }
+    let d = a
+        .positions
+        .iter()
+        .zip(&b.positions)
+        .map(|(p, q)| meshwork_core::geometry::dist(*p, *q))
+        .fold(0.0, f64::max);
+    d / Aabb::of(&a.positions).map_or(1.0, |x| x.diagonal())
+}
+
 /// Max distance at a's vertices and face centroids to surface b, and vice versa, over b's diagonal.
 fn own_hausdorff(a: &Mesh, b: &Mesh) -> f64 {
     let samples = |m: &Mesh| -> Vec<Point3> {
@@ -210,6 +238,34 @@ fn cases() -> Vec<Case> {
     v.push(case("ico500-ell100k", vec![icosphere(3, 1.0), ellipsoid(7, [1.5, 1.0, 0.7])], plain.clone()));
     v.push(case("homer-self", vec![shared("homer"), shared("homer")], plain.clone()));
     v.push(case("fandisk-self", vec![shared("fandisk"), shared("fandisk")], plain.clone()));
+    v.push(case("homer-rotscale", vec![shared("homer"), rotated_scaled(&shared("homer"))], plain.clone()));
+    v.push(case(
+        "fandisk-rotscale",
+        vec![shared("fandisk"), rotated_scaled(&shared("fandisk"))],
+        plain.clone(),
+    ));
+    v.push(case("cow-rotscale", vec![shared("cow"), rotated_scaled(&shared("cow"))], rep.clone()));
+    v.push(case(
+        "teapot-homer-sphere",
+        vec![shared("teapot"), shared("homer")],
+        json!({"frames": 10, "repair": true, "domain": "sphere"}),
+    ));
+    v.push(case(
+        "beetle-fandisk-sphere",
+        vec![shared("beetle"), shared("fandisk")],
+        json!({"frames": 10, "repair": true, "domain": "sphere"}),
+    ));
+    v.push(case("woody-self", vec![shared("woody"), shared("woody")], rep.clone()));
+    v.push(case(
+        "features-woody-alligator",
+        vec![shared("woody"), shared("alligator")],
+        json!({"frames": 10, "repair": true, "features": [[0, 0], [300, 1500], [600, 3000]]}),
+    ));
+    v.push(case(
+        "pseudo-woody-alligator",
+        vec![shared("woody"), shared("alligator")],
+        json!({"frames": 10, "repair": true, "correspondence": "pseudo"}),
+    ));
     v.push(case("homer-rotmirror", vec![shared("homer"), rotated_mirrored(&shared("homer"))], plain.clone()));
     v.push(case(
         "fandisk-rotmirror-icp",
@@ -262,8 +318,8 @@ fn fmt_pair(r: &Value, k: &str) -> String {
 
 fn main() {
     let filters: Vec<String> = std::env::args().skip(1).collect();
-    println!("| case | inputs (V) | result | foldovers | AD | SD | H first/last (job) | H first (own) | metamesh V | time s |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| case | inputs (V) | result | foldovers | AD | SD | H first/last (job) | H first (own) | motion | metamesh V | time s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for c in cases() {
         if !filters.is_empty() && !filters.iter().any(|f| c.name.contains(f.as_str())) {
             continue;
@@ -281,9 +337,9 @@ fn main() {
             Err(p) => {
                 let msg =
                     p.downcast_ref::<String>().cloned().or(p.downcast_ref::<&str>().map(|s| s.to_string()));
-                format!("PANIC {} | | | | | | | ", msg.unwrap_or_default().replace('|', "/"))
+                format!("PANIC {} | | | | | | | | ", msg.unwrap_or_default().replace('|', "/"))
             }
-            Ok(Err(e)) => format!("error: {} | | | | | | | ", e.to_string().replace('|', "/")),
+            Ok(Err(e)) => format!("error: {} | | | | | | | | ", e.to_string().replace('|', "/")),
             Ok(Ok(o)) => {
                 let r = &o.report;
                 let own = if r["domain"] == "spherical" && c.params.get("blend_weights").is_none() {
@@ -298,7 +354,7 @@ fn main() {
                     .get("max_feature_gap_after")
                     .map_or(String::new(), |x| format!(" feat {x}"));
                 format!(
-                    "ok {} {}{} | {} | {} | {} | {:.1e}/{:.1e} | {} | {} | ",
+                    "ok {} {}{} | {} | {} | {} | {:.1e}/{:.1e} | {} | {:.1e} | {} | ",
                     r["domain"].as_str().unwrap_or("?"),
                     r["correspondence"].as_str().unwrap_or(""),
                     feat,
@@ -308,6 +364,7 @@ fn main() {
                     r["hausdorff_first_frame"].as_f64().unwrap_or(f64::NAN),
                     r["hausdorff_last_frame"].as_f64().unwrap_or(f64::NAN),
                     own,
+                    if o.meshes.len() >= 2 { motion(&o.meshes[0], &o.meshes[1]) } else { f64::NAN },
                     r["metamesh_vertices"],
                 )
             }

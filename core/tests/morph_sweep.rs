@@ -211,3 +211,41 @@ fn self_morph_keeps_the_overlay() {
         assert!(d / diag(&a.positions) < 1e-9, "frame off the input by {d}");
     }
 }
+
+/// PCA sign rule: a rotated, scaled and moved copy of a shape has the same normalised form
+/// (truth: the copy's construction). Checked on an asymmetric analytic shape and on homer.
+#[test]
+fn pca_frame_is_invariant_under_similarity() {
+    let k = normalize([1.0, 2.0, 3.0]);
+    let (s, c) = 0.7f64.sin_cos();
+    let similar = |p: Point3| -> Point3 {
+        let kxp = cross(k, p);
+        let kdp = dot(k, p);
+        let r: Vec<f64> = (0..3).map(|i| p[i] * c + kxp[i] * s + k[i] * kdp * (1.0 - c)).collect();
+        [3.5 * r[0] + 10.0, 3.5 * r[1], 3.5 * r[2] - 4.0]
+    };
+    // An egg: ellipsoid with one end fatter (third moments non-zero on every axis).
+    let mut egg = ellipsoid(3, [2.0, 1.0, 0.6]);
+    for p in &mut egg.positions {
+        let f = 1.0 + 0.25 * p[0] + 0.15 * p[1] + 0.1 * p[2];
+        *p = [p[0], p[1] * f, p[2] * f];
+    }
+    let homer = {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes/homer.obj");
+        let bytes = std::fs::read(&p).expect("homer.obj");
+        meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
+    };
+    for m in [egg, homer] {
+        let t = tris_of(&m);
+        let copy: Vec<Point3> = m.positions.iter().map(|&p| similar(p)).collect();
+        let fa = meshwork_core::register::pca_frame(&m.positions, &t).to_normalised;
+        let fb = meshwork_core::register::pca_frame(&copy, &t).to_normalised;
+        let d = m
+            .positions
+            .iter()
+            .zip(&copy)
+            .map(|(&p, &q)| norm(sub(fa.apply(p), fb.apply(q))))
+            .fold(0.0, f64::max);
+        assert!(d < 1e-9, "normalised copies differ by {d}");
+    }
+}
