@@ -2,7 +2,8 @@
 //! each other (Procrustes about the centre on the feature points), then every feature point is
 //! moved towards the normalised mean of its partners by a stepwise compactly supported RBF warp
 //! (CTPS C²a with a linear polynomial, seed 002 Table V.1 row 7), re-projecting onto the sphere
-//! after each step. A step that would flip a spherical triangle is undone and split in two.
+//! after each step. A step that would flip a spherical triangle is split in two; vertex moves that
+//! would flip a sliver of the map (rounding alone does that) are held back (`held_vertices`).
 //!
 //! CTPS C²a: φ(h) = 1 − 30h² − 10h³ + 45h⁴ − 6h⁵ − 60h³·ln h for h < 1, else 0. The thesis prints
 //! log₂; with log₂ φ'(1) = 60 − 60/ln 2 ≠ 0, so the function would not be C² (not even C¹) at
@@ -16,6 +17,7 @@ use crate::mesh::Point3;
 use crate::register::{mat_vec, procrustes, solve_dense};
 
 use super::param::count_foldovers;
+use super::sphere_fallback::orient_sign;
 
 /// CTPS C²a (natural log; see the module docs).
 pub fn ctps_c2a(h: f64) -> f64 {
@@ -113,6 +115,9 @@ pub struct AlignReport {
     /// Largest angle (radians) between a feature point and its goal before and after the warp.
     pub max_feature_gap_before: f64,
     pub max_feature_gap_after: f64,
+    /// Vertex moves undone because they would have flipped a spherical triangle (summed over
+    /// steps and inputs; those vertices keep their place for that step).
+    pub held_vertices: usize,
     /// Faces flipped after alignment (must be 0).
     pub foldovers: usize,
 }
@@ -190,9 +195,16 @@ pub fn align(
             let warp = RbfWarp::fit(&centres, &disp, s.support_radius)?;
             let moved: Vec<Point3> =
                 spheres[k].iter().map(|&x| normalize(add(x, warp.displacement(x)))).collect();
-            if count_foldovers(&moved, tris[k]) == 0 {
+            let (moved, held) = hold_folding_vertices(&spheres[k], moved, tris[k]);
+            // A few held vertices are slivers of the map flipped by rounding alone (no step is
+            // small enough for them); many, or a held feature, mean the step itself folds.
+            let feature_held = idx.iter().any(|&v| held[v]);
+            let n_held = held.iter().filter(|&&h| h).count();
+            let small = n_held <= 8 + spheres[k].len() / 1000;
+            if n_held == 0 || (small && (!feature_held || depth >= 8)) {
                 spheres[k] = moved;
                 steps_done += 1;
+                rep.held_vertices += n_held;
             } else if depth < 8 {
                 // Go half-way from where the features are now, then on to t.
                 let cur_t = features_progress(&spheres[k], &idx, &start, &goals);
@@ -207,6 +219,35 @@ pub fn align(
     rep.max_feature_gap_after = gap(spheres);
     rep.foldovers = (0..k_in).map(|k| count_foldovers(&spheres[k], tris[k])).sum();
     Ok(rep)
+}
+
+/// The moves of one warp step without the ones that fold: every vertex of a spherical triangle
+/// the step would flip (exact orientation test) keeps its old position, repeated until no
+/// triangle is flipped. Terminates: at worst every vertex is held, which is the old, valid map.
+fn hold_folding_vertices(
+    old: &[Point3],
+    mut moved: Vec<Point3>,
+    tris: &[[u32; 3]],
+) -> (Vec<Point3>, Vec<bool>) {
+    let mut held = vec![false; old.len()];
+    loop {
+        let mut changed = false;
+        for t in tris {
+            let [a, b, c] = t.map(|v| moved[v as usize]);
+            if orient_sign(a, b, c) <= 0 {
+                for &v in t {
+                    if !held[v as usize] {
+                        held[v as usize] = true;
+                        moved[v as usize] = old[v as usize];
+                        changed = true;
+                    }
+                }
+            }
+        }
+        if !changed {
+            return (moved, held);
+        }
+    }
 }
 
 /// How far (0..1) the features have come along their arcs, the smallest over features.
