@@ -275,3 +275,41 @@ fn repaired_cow_takes_the_better_tutte_map_inside_the_seed_range() {
     assert_eq!(out.report["foldovers"], serde_json::json!([0, 0]));
     assert!(out.report["hausdorff_first_frame"].as_f64().unwrap() <= 1e-3);
 }
+
+/// Feature pairs are honoured on fallback maps too: the stepwise warp moves the paired vertices
+/// together (checked on the output meshes, not the report).
+#[test]
+fn feature_pairs_meet_on_the_fallback_map() {
+    let a = shapes::icosphere(3, 1.0);
+    let b = ellipsoid(3, [1.5, 1.0, 0.7]);
+    let nearest = |m: &Mesh, d: Point3| -> u32 {
+        (0..m.positions.len())
+            .max_by(|&i, &j| dot(m.positions[i], d).total_cmp(&dot(m.positions[j], d)))
+            .expect("non-empty") as u32
+    };
+    // Mismatched on purpose: a's +y pole onto b's +x tip, a's +z onto b's −y.
+    let pairs = [
+        (nearest(&a, [0.0, 1.0, 0.0]), nearest(&b, [1.0, 0.0, 0.0])),
+        (nearest(&a, [0.0, 0.0, 1.0]), nearest(&b, [0.0, -1.0, 0.0])),
+    ];
+    let out = job::run(
+        JobKind::Morph,
+        vec![a.clone(), b.clone()],
+        serde_json::json!({
+            "registration": "none",
+            "sphere_method": "tutte",
+            "features": pairs.iter().map(|&(x, y)| vec![x, y]).collect::<Vec<_>>(),
+        }),
+        &Progress::new(),
+    )
+    .expect("morph");
+    assert_eq!(out.report["param_method"], serde_json::json!(["fallback_tutte", "fallback_tutte"]));
+    let (m0, m1) = (&out.meshes[0].positions, &out.meshes[1].positions);
+    let diag = bbox_diag(&b.positions);
+    for &(va, vb) in &pairs {
+        let k = m0.iter().position(|p| *p == a.positions[va as usize]).expect("a's vertex in the metamesh");
+        let gap = norm(sub(m1[k], b.positions[vb as usize])) / diag;
+        assert!(gap < 1e-3, "feature ({va}, {vb}) ends {gap} of the diagonal apart");
+    }
+    assert_eq!(out.report["features"]["foldovers"], 0);
+}

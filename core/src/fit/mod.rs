@@ -38,7 +38,7 @@ pub mod uvs;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::geometry::{add, dist, sub, Aabb};
+use crate::geometry::{add, dist, scale, sub, Aabb};
 use crate::job::{Output, Progress, Stages};
 use crate::mesh::{Faces, Mesh, Point3};
 
@@ -292,10 +292,19 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     };
     let fine_tris = if keep_groups { tris.clone() } else { Vec::new() };
     let fine_positions = mesh.pos.clone();
-    let reference_normals = report::vertex_normals(&fine_positions, &tris);
+    let mut reference_normals = report::vertex_normals(&fine_positions, &tris);
     let realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
+    parents.extend_from_slice(&realised.added);
+    // Vertices split into crossed edges take the reference normal of their edge.
+    for a in &realised.added {
+        let n = add(
+            scale(reference_normals[a[0].0 as usize], a[0].1),
+            scale(reference_normals[a[1].0 as usize], a[1].1),
+        );
+        reference_normals.push(crate::geometry::normalize(n));
+    }
     let mut curve_edges = untangle::EdgeSet::default();
     for c in &realised.chains {
         for p in c.windows(2) {

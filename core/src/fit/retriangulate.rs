@@ -40,6 +40,10 @@ pub struct RetriStats {
     pub walked: usize,
     /// Free mesh vertices snapped onto a segment (they become chain vertices).
     pub snapped_vertices: usize,
+    /// Segments (or pieces) whose strip could not be re-triangulated and had their crossed edges
+    /// split instead, and the vertices that added.
+    pub split_segments: usize,
+    pub split_vertices: usize,
     /// Segments that needed the Dijkstra-and-project fallback.
     pub fallback_segments: usize,
     /// Vertices the fallback moved onto a segment.
@@ -74,6 +78,9 @@ pub struct Realised {
     pub chains: Vec<Vec<u32>>,
     /// Vertices on some chain (curve vertices and those added to chains).
     pub on_curve: Vec<bool>,
+    /// Vertices added by splitting crossed edges (ids after the input mesh's, in order): the two
+    /// edge ends and weights (third entry unused, weight 0), for attribute interpolation.
+    pub added: Vec<[(u32, f64); 3]>,
     pub stats: RetriStats,
     /// Vertices moved over the surface (snapped or pulled onto a segment), in move order, with
     /// where their new position lies on the mesh before the move: their UVs follow ([`super::uvs`]).
@@ -154,6 +161,7 @@ pub fn realise(
     let mut locked_edges = EdgeSet::default();
     let mut stats = RetriStats { segments: net.segments.len(), ..Default::default() };
     let mut chains = Vec::with_capacity(net.segments.len());
+    let mut added = Vec::new();
     let mut uv_moves = Vec::new();
     for (si, seg) in net.segments.iter().enumerate() {
         if si % 256 == 0 {
@@ -174,6 +182,7 @@ pub fn realise(
                 &mut on_curve,
                 &locked_edges,
                 &mut chain,
+                &mut added,
                 &mut stats,
                 &mut uv_moves,
             );
@@ -213,7 +222,7 @@ pub fn realise(
         }
         chains.push(chain);
     }
-    Ok(Realised { chains, on_curve, stats, uv_moves })
+    Ok(Realised { chains, on_curve, added, stats, uv_moves })
 }
 
 /// Walks and re-triangulates from u to w, possibly in pieces at snapped vertices. Pushes chain
@@ -224,9 +233,10 @@ fn walk_segment(
     u: u32,
     w: u32,
     snap_fraction: f64,
-    on_curve: &mut [bool],
+    on_curve: &mut Vec<bool>,
     locked_edges: &EdgeSet,
     chain: &mut Vec<u32>,
+    added: &mut Vec<[(u32, f64); 3]>,
     stats: &mut RetriStats,
     uv_moves: &mut Vec<super::uvs::UvMove>,
 ) -> bool {
@@ -270,9 +280,20 @@ fn walk_segment(
                     mesh.pos[end as usize] = target;
                 }
                 if !retriangulate(mesh, cur, end, &faces, &crossed) {
-                    mesh.pos[end as usize] = old;
+                    // No valid re-triangulation of the strip with the same face count (it wraps
+                    // around a vertex, or an ear would need an existing edge): split every edge
+                    // the segment crosses instead, at the crossing (Li's insertion; +2 faces per
+                    // crossed edge). The walk already proved the strip connects cur to end.
                     stats.walk_fail_fill += 1;
-                    return false;
+                    let n0 = chain.len();
+                    if !split_strip(mesh, &cut, &crossed, on_curve, added, chain) {
+                        if chain.len() == n0 {
+                            mesh.pos[end as usize] = old;
+                        }
+                        return false;
+                    }
+                    stats.split_vertices += chain.len() - n0;
+                    stats.split_segments += 1;
                 }
                 uv_moves.extend(moved);
                 chain.push(end);
@@ -394,6 +415,48 @@ fn walk(
         (l, r, cur) = (nl, nr, g);
     }
     Walk::Fail(FailReason::Lost)
+}
+
+/// Splits every crossed edge (l, r) of a strip where the cut plane crosses it, pushing the new vertices onto `chain`. False if an edge is no longer there (nothing else done
+/// for it; the chain stays valid up to its last vertex).
+fn split_strip(
+    mesh: &mut TriMesh,
+    cut: &Cut,
+    crossed: &[(u32, u32)],
+    on_curve: &mut Vec<bool>,
+    added: &mut Vec<[(u32, f64); 3]>,
+    chain: &mut Vec<u32>,
+) -> bool {
+    for &(l, r) in crossed {
+        let (c, lam) = crossing(mesh, cut, l, r);
+        // At the crossing itself (on the surface): moving it onto the straight segment would fold
+        // the split faces where the strip is long and curved.
+        let Some(m) = split_edge(mesh, l, r, c) else { return false };
+        added.push([(l, 1.0 - lam), (r, lam), (l, 0.0)]);
+        on_curve.push(true);
+        chain.push(m);
+    }
+    true
+}
+
+/// Splits edge (a, b) at `x` and the one or two faces on it; the new vertex's id.
+fn split_edge(mesh: &mut TriMesh, a: u32, b: u32, x: Point3) -> Option<u32> {
+    let faces: Vec<u32> =
+        [mesh.face_with_edge(a, b), mesh.face_with_edge(b, a)].into_iter().flatten().collect();
+    if faces.is_empty() {
+        return None;
+    }
+    let m = mesh.add_vertex(x);
+    for f in faces {
+        let t = mesh.tris[f as usize];
+        let k = (0..3).find(|&k| (t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a))?;
+        let (p, q, r) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        mesh.remove_face(f);
+        // The removed face freed its directed edges; p→m, m→q and the edges at m are new.
+        mesh.add_face([p, m, r]).ok()?;
+        mesh.add_face([m, q, r]).ok()?;
+    }
+    Some(m)
 }
 
 /// Where the cut plane crosses edge (l, r) (s(l) ≥ 0 > s(r)): the point and its parameter from l.

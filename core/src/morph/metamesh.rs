@@ -85,12 +85,17 @@ pub(super) fn inside(s: &[Point3], t: [u32; 3], p: Point3) -> bool {
 }
 
 /// Whether A-edge (a0, a1) and B-edge (b0, b1) (both canonical, low < high) cross.
+/// When each arc straddles the other's great circle, the circles meet at ±x (x = n_a × n_b) and
+/// each arc (< 180°) passes through the one on its own midpoint's side: they cross iff that is
+/// the same point. (Comparing the two midpoints directly is only right for short arcs; the
+/// arcs of a coarse embedding, e.g. a tetrahedron's 109°, got it wrong: found by the sweep.)
 #[inline]
 fn crosses(sa: &[Point3], a0: u32, a1: u32, sb: &[Point3], b0: u32, b1: u32) -> bool {
     let (pa0, pa1, pb0, pb1) = (sa[a0 as usize], sa[a1 as usize], sb[b0 as usize], sb[b1 as usize]);
-    left(sa, a0, a1, pb0) != left(sa, a0, a1, pb1)
-        && left(sb, b0, b1, pa0) != left(sb, b0, b1, pa1)
-        && dot(add(pa0, pa1), add(pb0, pb1)) > 0.0
+    left(sa, a0, a1, pb0) != left(sa, a0, a1, pb1) && left(sb, b0, b1, pa0) != left(sb, b0, b1, pa1) && {
+        let x = cross(cross(pa0, pa1), cross(pb0, pb1));
+        (dot(x, add(pa0, pa1)) > 0.0) == (dot(x, add(pb0, pb1)) > 0.0)
+    }
 }
 
 /// Where the great arcs (a0, a1) and (b0, b1) meet, on the side of the arcs.

@@ -24,6 +24,7 @@ pub mod glb;
 pub mod interpolate;
 pub mod metamesh;
 pub mod output;
+pub mod overlay_degenerate;
 pub mod param;
 pub mod planar;
 pub mod planar_job;
@@ -357,40 +358,49 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     }
 
     // 5. Correspondence: chain overlays (or transfers) through the inputs.
-    let (layer, overlay_reps, fallback, pseudo_reps) = stages.run(progress, "metamesh", || {
-        let layers: Vec<Layer> = normalised
-            .iter()
-            .zip(&spheres)
-            .map(|(m, s)| Layer { sphere: s.clone(), tris: m.tris.clone(), shapes: vec![m.pos.clone()] })
-            .collect();
-        let mut acc = layers[0].clone();
-        let mut reps = Vec::new();
-        let mut fallback: Option<String> = None;
-        let mut pseudo_reps = Vec::new();
-        for l in &layers[1..] {
-            acc = match params.correspondence {
-                Correspondence::Overlay => match metamesh::overlay(&acc, l, progress) {
-                    Ok((o, r)) => {
-                        reps.push(r);
-                        o
+    let (layer, overlay_reps, fallback, pseudo_reps, perturbation) =
+        stages.run(progress, "metamesh", || {
+            let layers: Vec<Layer> = normalised
+                .iter()
+                .zip(&spheres)
+                .map(|(m, s)| Layer { sphere: s.clone(), tris: m.tris.clone(), shapes: vec![m.pos.clone()] })
+                .collect();
+            let mut acc = layers[0].clone();
+            let mut reps = Vec::new();
+            let mut fallback: Option<String> = None;
+            let mut pseudo_reps = Vec::new();
+            let mut perturbation = Vec::new();
+            for l in &layers[1..] {
+                acc = match params.correspondence {
+                    Correspondence::Overlay => match overlay_degenerate::overlay(&acc, l, progress) {
+                        Ok((o, r, angle)) => {
+                            reps.push(r);
+                            perturbation.push(angle);
+                            o
+                        }
+                        Err(Error::Numerical { message, .. }) => {
+                            fallback =
+                                Some(format!("overlay failed ({message}); used the barycentric transfer"));
+                            metamesh::transfer(&acc, l, progress)?
+                        }
+                        Err(e) => return Err(e),
+                    },
+                    Correspondence::Transfer => metamesh::transfer(&acc, l, progress)?,
+                    Correspondence::Pseudo => {
+                        let (p, r) = pseudo::pseudo(
+                            &acc,
+                            l,
+                            pseudo::Domain::Sphere,
+                            params.pseudo_max_depth,
+                            progress,
+                        )?;
+                        pseudo_reps.push(r);
+                        p
                     }
-                    Err(Error::Numerical { message, .. }) => {
-                        fallback = Some(format!("overlay failed ({message}); used the barycentric transfer"));
-                        metamesh::transfer(&acc, l, progress)?
-                    }
-                    Err(e) => return Err(e),
-                },
-                Correspondence::Transfer => metamesh::transfer(&acc, l, progress)?,
-                Correspondence::Pseudo => {
-                    let (p, r) =
-                        pseudo::pseudo(&acc, l, pseudo::Domain::Sphere, params.pseudo_max_depth, progress)?;
-                    pseudo_reps.push(r);
-                    p
-                }
-            };
-        }
-        Ok((acc, reps, fallback, pseudo_reps))
-    })?;
+                };
+            }
+            Ok((acc, reps, fallback, pseudo_reps, perturbation))
+        })?;
 
     // Back in input 0's coordinates.
     let back = frames_out[0].inverse();
@@ -446,6 +456,8 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         },
         "correspondence_fallback": fallback,
         "overlays": overlay_reps,
+        // Radians the target's embedding was rotated so the overlay could be built (0: exact).
+        "overlay_perturbation": perturbation,
         "pseudo_metamesh": pseudo_reps,
         "domain": "spherical",
         "domain_reason": reason,
