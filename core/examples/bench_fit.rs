@@ -40,7 +40,7 @@ struct Case {
 /// truth face closest to its centroid (among the faces around the nearest truth vertex's
 /// neighbours). Independent of the job's own `flipped_faces` (which compares with its fine-stage
 /// surface). Applied to the truth itself it counts 0 (`--inherent`).
-fn truth_flips(c: &Case, out: &Mesh) -> usize {
+fn truth_flips(c: &Case, out: &Mesh, report: &serde_json::Value) -> usize {
     use meshwork_core::fit::kdtree::KdTree;
     use meshwork_core::geometry::{dist, dot, triangle_cross};
     use meshwork_core::spatial::closest_on_triangle;
@@ -55,6 +55,24 @@ fn truth_flips(c: &Case, out: &Mesh) -> usize {
     let tree = KdTree::new(&truth);
     let corners = |f: u32| tris[f as usize].map(|v| truth[v as usize]);
     let debug = std::env::var("FIT_DEBUG").is_ok();
+    // The output drops the vertices the clean-up removed and renumbers the rest in order: the
+    // fit's own vertex id of each output vertex (template vertices are the first ones).
+    let mut removed: Vec<u64> = report["cleanup"]["removed_vertices"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|v| v.as_u64()).collect())
+        .unwrap_or_default();
+    removed.sort_unstable();
+    let mut fit_id = Vec::with_capacity(out.positions.len());
+    let (mut id, mut k) = (0u64, 0usize);
+    while fit_id.len() < out.positions.len() {
+        if k < removed.len() && removed[k] == id {
+            k += 1;
+        } else {
+            fit_id.push(id as usize);
+        }
+        id += 1;
+    }
+    let template_vertex = |v: u32| Some(fit_id[v as usize]).filter(|&i| i < truth.len());
     out.faces
         .iter()
         .filter(|f| {
@@ -75,8 +93,9 @@ fn truth_flips(c: &Case, out: &Mesh) -> usize {
             let n = triangle_cross(p(0), p(1), p(2));
             // A face of template vertices has its own truth: the same corners on the bent
             // template (the closest truth face can be on the other side of a thin part).
-            let tn = if f.iter().all(|&v| (v as usize) < truth.len()) {
-                triangle_cross(truth[f[0] as usize], truth[f[1] as usize], truth[f[2] as usize])
+            let tv: Vec<usize> = f.iter().filter_map(|&v| template_vertex(v)).collect();
+            let tn = if tv.len() == 3 {
+                triangle_cross(truth[tv[0]], truth[tv[1]], truth[tv[2]])
             } else {
                 let q = corners(best.1);
                 triangle_cross(q[0], q[1], q[2])
@@ -117,7 +136,7 @@ fn time_fit(c: &Case, reps: usize) -> (f64, serde_json::Value) {
             run(vec![c.template.clone(), c.curves.clone()], &c.params, &Progress::new()).expect("fit");
         let s = t.elapsed().as_secs_f64();
         if s < best.0 {
-            out.report["truth_flipped_faces"] = truth_flips(c, &out.meshes[0]).into();
+            out.report["truth_flipped_faces"] = truth_flips(c, &out.meshes[0], &out.report).into();
             best = (s, out.report);
         }
     }
@@ -162,7 +181,7 @@ fn main() {
             }
             println!(
                 "homer split {split}: {} of {} truth faces oppose the truth measure",
-                truth_flips(&c, &exact),
+                truth_flips(&c, &exact, &serde_json::Value::Null),
                 exact.face_count()
             );
         }
@@ -181,7 +200,11 @@ fn main() {
         }
         return;
     }
-    println!("== headline: 96k-vertex template, full section network ==");
+    println!(
+        "== headline: 96k-vertex template, full section network ({} regions expected, counted by \
+         testdata::section_regions) ==",
+        meshwork_core::fit::testdata::section_regions(&homer, &planes(true))
+    );
     for smooth in [false, true] {
         let c = case(&homer, 2, 1, true, smooth);
         let (s, r) = time_fit(&c, 3);

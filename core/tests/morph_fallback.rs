@@ -313,3 +313,20 @@ fn feature_pairs_meet_on_the_fallback_map() {
     }
     assert_eq!(out.report["features"]["foldovers"], 0);
 }
+
+/// The smallest closed surface: one vertex removed leaves a triangle with no interior vertex.
+#[test]
+fn tutte_fallback_embeds_a_tetrahedron() {
+    let pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let tris = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let t = TriMesh { pos, tris };
+    let map = param::parameterise(&t, &tutte_settings(), &Progress::new()).expect("tetrahedron");
+    eprintln!("tetrahedron: {:?} {:?}", map.report.tutte, map.sphere);
+    assert_eq!(map.report.foldovers, 0);
+    assert_covers_sphere_once("tetrahedron", &map.sphere, &t.tris);
+    // Not squashed: every chord triangle keeps a real area (a regular tetrahedron's is 0.65).
+    for tr in &t.tris {
+        let q = tr.map(|v| map.sphere[v as usize]);
+        assert!(norm(cross(sub(q[1], q[0]), sub(q[2], q[0]))) / 2.0 > 0.05, "{tr:?}");
+    }
+}

@@ -673,3 +673,55 @@ fn dijkstra_project(
     }
     Some(path)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splitting_the_crossed_edges_makes_the_segment_a_chain() {
+        // A strip of 4 triangles in the plane z = 0 between u = 0 at (0, 0) and w = 5 at (3, 0):
+        // upper vertices 1 (0.5, 1), 3 (1.5, 1), lower 2 (1, -1), 4 (2, -1). The segment u–w
+        // crosses edges 1-2, 2-3 and 3-4 (hand count), so 3 new vertices at y = 0 join u to w.
+        let pos = vec![
+            [0.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.5, 1.0, 0.0],
+            [2.0, -1.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
+        let tris = vec![[0, 2, 1], [1, 2, 3], [2, 4, 3], [3, 4, 5]];
+        let mut mesh = TriMesh::new(pos, tris).unwrap();
+        let cut = Cut { a: [0.0; 3], dir: [1.0, 0.0, 0.0], side: [0.0, 1.0, 0.0], len: 3.0 };
+        let crossed = [(1, 2), (3, 2), (3, 4)];
+        let (mut on_curve, mut added, mut chain) = (vec![false; 6], Vec::new(), vec![0]);
+        assert!(split_strip(&mut mesh, &cut, &crossed, &mut on_curve, &mut added, &mut chain));
+        chain.push(5);
+        assert_eq!(chain.len(), 5);
+        for w in chain.windows(2) {
+            assert!(mesh.has_edge(w[0], w[1]), "{w:?} is not an edge");
+        }
+        for &v in &chain[1..4] {
+            assert!(mesh.pos[v as usize][1].abs() < 1e-12, "new vertex off the segment");
+        }
+        // Every crossed edge split its two faces (or one): 4 + 2 × 3 faces, all still
+        // counter-clockwise (+z).
+        let live = mesh.live_triangles();
+        assert_eq!(live.len(), 10);
+        for t in &live {
+            let n = crate::geometry::triangle_cross(
+                mesh.pos[t[0] as usize],
+                mesh.pos[t[1] as usize],
+                mesh.pos[t[2] as usize],
+            );
+            assert!(n[2] > 0.0, "{t:?} turned over");
+        }
+        assert_eq!((added.len(), on_curve.len()), (3, 9));
+        // The interpolation weights reproduce the new positions.
+        for (i, a) in added.iter().enumerate() {
+            let p = add(scale(mesh.pos[a[0].0 as usize], a[0].1), scale(mesh.pos[a[1].0 as usize], a[1].1));
+            assert!(crate::geometry::dist(p, mesh.pos[6 + i]) < 1e-12);
+        }
+    }
+}

@@ -186,13 +186,15 @@ pub fn parameterise(mesh: &TriMesh, s: &ParamSettings, progress: &Progress) -> R
                 m.report.retries,
                 progress,
             ),
-            Err(Error::Numerical { message, .. }) => tutte_fallback(
-                mesh,
-                s,
-                format!("the progressive map failed: {message}"),
-                Vec::new(),
-                progress,
-            ),
+            Err(Error::Numerical { message, .. }) => {
+                let why = format!("the progressive map failed: {message}");
+                tutte_fallback(mesh, s, why.clone(), Vec::new(), progress).map_err(|e| match e {
+                    Error::Numerical { message: m, .. } => {
+                        Error::numerical("parameterise", format!("{why}; the Tutte fallback failed too: {m}"))
+                    }
+                    e => e,
+                })
+            }
             Err(e) => Err(e),
         },
     }

@@ -376,7 +376,7 @@ fn tutte_layout(mesh: &TriMesh, v0: u32, link: &[u32], weights: TutteWeights) ->
     let mut diag = vec![0.0; nf];
     let mut rhs = vec![0.0; 2 * nf];
     let mut edges: Vec<((u32, u32), f64)> = w.into_iter().collect();
-    edges.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    edges.sort_unstable_by_key(|e| e.0);
     for ((a, b), x) in edges {
         let x = clamp(x);
         for (i, j) in [(a, b), (b, a)] {
@@ -559,8 +559,8 @@ fn normalise(
             } else {
                 let best = simplex[0].0;
                 for e in simplex.iter_mut().skip(1) {
-                    for k in 0..3 {
-                        e.0[k] = best[k] + 0.5 * (e.0[k] - best[k]);
+                    for (x, b) in e.0.iter_mut().zip(best) {
+                        *x = b + 0.5 * (*x - b);
                     }
                     e.1 = eval(e.0);
                 }
@@ -573,8 +573,11 @@ fn normalise(
     Ok((sphere, Normalisation { scale: x[0].exp(), translation: [x[1], x[2]], sd_before, sd_after: fx }))
 }
 
-/// Step 5: the fold-free mean-value relaxation in batches, each verified exactly; a batch that
-/// flips a triangle is undone and ends the relaxation. Returns (sweeps kept, sweeps undone).
+/// Step 5: the fold-free mean-value relaxation in batches, each verified exactly. A batch that
+/// flips a triangle, or raises AD + SD (the relaxation is there to lower distortion; on tiny
+/// meshes such as a tetrahedron the mean-value target of a vertex is near its antipode and the
+/// sweeps only squash the triangles), is undone and ends the relaxation.
+/// Returns (sweeps kept, sweeps undone).
 fn relax_checked(
     mesh: &TriMesh,
     sphere: &mut [Point3],
@@ -588,15 +591,22 @@ fn relax_checked(
     let batch = s.relax_batch.max(1);
     let mut kept = 0;
     let mut undone = 0;
+    let score = |sphere: &[Point3]| {
+        let (ad, sd) = distortion(&mesh.pos, sphere, &mesh.tris);
+        ad + sd
+    };
+    let mut current = score(sphere);
     while kept < s.relax_sweeps {
         let k = batch.min(s.relax_sweeps - kept);
         let before = sphere.to_vec();
         param::relax(&h, &mesh.pos, sphere, k, progress)?;
-        if count_foldovers_exact(sphere, &mesh.tris) > 0 {
+        let next = score(sphere);
+        if count_foldovers_exact(sphere, &mesh.tris) > 0 || next.is_nan() || next > current {
             sphere.copy_from_slice(&before);
             undone += k;
             break;
         }
+        current = next;
         kept += k;
     }
     Ok((kept, undone))
