@@ -249,3 +249,41 @@ fn pca_frame_is_invariant_under_similarity() {
         assert!(d < 1e-9, "normalised copies differ by {d}");
     }
 }
+
+/// Planar domain, one interior feature pair (woody vertex 300, alligator vertex 1500, both off the
+/// rim): the pair must meet (truth: the request itself), so the metamesh vertex that is woody's
+/// vertex 300 in the first frame is alligator's vertex 1500 in the last.
+/// KNOWN FAILURE (gap 0.08 in plane units): the pair's goal lies near the rim (r ≈ 0.93) and
+/// the stepwise planar warp flips a rim triangle at every step size (the rim vertices are dragged
+/// and projected back; fading the warp out towards a fixed rim only gets the gap to 0.048, as the
+/// band between feature and rim must be compressed, not translated). For the planar domain's
+/// owner; run with `--ignored`.
+#[test]
+#[ignore = "known failure: planar feature warp toward the rim stalls (docs/benchmarks.md, Morph sweep)"]
+fn planar_interior_feature_pair_meets() {
+    let load = |n: &str| {
+        let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../shared/meshes/{n}.obj"));
+        meshwork_core::io::read(&std::fs::read(&p).expect("mesh file"), &Default::default())
+            .expect("readable")
+            .mesh
+    };
+    let (a, b) = (load("woody"), load("alligator"));
+    let o = job::run(
+        JobKind::Morph,
+        vec![a.clone(), b.clone()],
+        json!({"frames": 3, "repair": true, "registration": "none", "features": [[300, 1500]]}),
+        &Progress::new(),
+    )
+    .expect("morph");
+    assert_eq!(o.report["domain"], "planar");
+    let gap = o.report["features"]["max_feature_gap_after"].as_f64().expect("gap");
+    assert!(gap < 1e-6, "feature gap after the warp {gap}");
+    let (first, last) = (&o.meshes[0], &o.meshes[1]);
+    let pa = a.positions[300];
+    let m = (0..first.positions.len())
+        .min_by(|&i, &j| norm(sub(first.positions[i], pa)).total_cmp(&norm(sub(first.positions[j], pa))))
+        .expect("vertices");
+    assert!(norm(sub(first.positions[m], pa)) < 1e-9 * diag(&a.positions));
+    let miss = norm(sub(last.positions[m], b.positions[1500])) / diag(&b.positions);
+    assert!(miss < 1e-4, "woody 300 ends {miss} of the diagonal from alligator 1500");
+}

@@ -119,7 +119,10 @@ pub fn smooth(
     let nv = pos.len();
     let r = rings(nv, tris);
     let mut stats = SmoothStats::default();
-    let q_start = tris.par_iter().map(|&t| face_quality(pos, t)).reduce(|| f64::INFINITY, f64::min);
+    // Normal and quality of every face at the current positions, kept up to date by the guard.
+    let mut shape: Vec<(Point3, f64)> = tris.par_iter().map(|&t| face_shape(pos, t)).collect();
+    let mut scratch = shape.clone();
+    let q_start = shape.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
     let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
     // Stage 1: modified mean-curvature flow.
@@ -176,7 +179,7 @@ pub fn smooth(
             };
         });
         // A halved step stays on the plane it was dropped onto (old and new are both on it).
-        commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut stats, |_, q| q);
+        commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q);
     }
     // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
     let reference = pos.to_vec();
@@ -206,9 +209,18 @@ pub fn smooth(
             *p = q;
         });
         // A halved step is dropped back onto the reference surface like a full one.
-        let kept = commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut stats, |v, q| {
-            closest_by_walk(&reference, tris, &r, ref_face[v], q).1
-        });
+        let kept = commit_safely(
+            pos,
+            &old,
+            proposed,
+            tris,
+            &r,
+            q_floor,
+            &mut shape,
+            &mut scratch,
+            &mut stats,
+            |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1,
+        );
         for v in kept {
             let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], pos[v as usize]);
             new_ref[v as usize] = f;
@@ -243,8 +255,20 @@ pub fn min_angle_quality(a: Point3, b: Point3, c: Point3) -> f64 {
     }
 }
 
-fn face_quality(pos: &[Point3], t: [u32; 3]) -> f64 {
-    min_angle_quality(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
+/// Normal (unnormalised) and [`min_angle_quality`] of a face, sharing the edge vectors.
+fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
+    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+    let (ab, ac) = (sub(b, a), sub(c, a));
+    let n = cross(ab, ac);
+    let (la, lb, lc) = (norm2(sub(c, b)), norm2(ac), norm2(ab));
+    let prod = if la <= lb && la <= lc {
+        lb * lc
+    } else if lb <= lc {
+        la * lc
+    } else {
+        la * lb
+    };
+    (n, if prod > 0.0 { norm2(n) / prod } else { 0.0 })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -258,12 +282,14 @@ fn commit_safely(
     tris: &[[u32; 3]],
     r: &Rings,
     q_floor: f64,
+    shape: &mut [(Point3, f64)],
+    new_shape: &mut [(Point3, f64)],
     stats: &mut SmoothStats,
     reproject: impl Fn(usize, Point3) -> Point3 + Sync,
 ) -> Vec<u32> {
     let nv = old.len();
     let mut cand = proposed;
-    let moves = cand.par_iter().zip(old).filter(|(a, b)| a != b).count();
+    let moves = cand.iter().zip(old).filter(|(a, b)| a != b).count();
     stats.moves += moves;
     if moves == 0 {
         pos.copy_from_slice(old);
@@ -271,24 +297,19 @@ fn commit_safely(
     }
     // A relative margin so that the reported angle, computed differently, cannot come out lower.
     let floor = q_floor * (1.0 + 1e-9);
-    let acceptable = |cand: &[Point3], t: [u32; 3], n_old: Point3, q_old: f64| {
-        let n = face_normal(cand, t);
-        if dot(n, n_old) <= 0.0 {
-            return false; // turned over (or degenerate)
-        }
-        let q = face_quality(cand, t);
-        q >= q_old || q >= floor
+    // Turned over (or degenerate), or worse and below the floor.
+    let acceptable = |(n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
+        dot(n, n_old) > 0.0 && (q >= q_old || q >= floor)
     };
-    // One pass over the faces: the old normal and quality, and whether the step is acceptable.
-    let before: Vec<(Point3, f64, bool)> = tris
-        .par_iter()
-        .map(|&t| {
-            let (n0, q0) = (face_normal(old, t), face_quality(old, t));
-            let moved = t.iter().any(|&v| cand[v as usize] != old[v as usize]);
-            (n0, q0, !moved || acceptable(&cand, t, n0, q0))
-        })
-        .collect();
-    let mut bad: Vec<u32> = (0..tris.len() as u32).filter(|&f| !before[f as usize].2).collect();
+    // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
+    // of which moved comes out the same).
+    new_shape
+        .par_iter_mut()
+        .zip(tris.par_iter())
+        .with_min_len(4096)
+        .for_each(|(ns, &t)| *ns = face_shape(&cand, t));
+    let mut bad: Vec<u32> =
+        (0..tris.len() as u32).filter(|&f| !acceptable(new_shape[f as usize], shape[f as usize])).collect();
     let mut halvings = vec![0u8; nv];
     let mut vmark = vec![false; nv];
     let mut fmark = vec![false; tris.len()];
@@ -327,11 +348,15 @@ fn commit_safely(
         bad = faces
             .into_iter()
             .filter(|&f| {
-                let (n0, q0, _) = before[f as usize];
-                !acceptable(&cand, tris[f as usize], n0, q0)
+                let now = face_shape(&cand, tris[f as usize]);
+                new_shape[f as usize] = now;
+                !acceptable(now, shape[f as usize])
             })
             .collect();
     }
+    // Every face's last evaluation is at the final positions (a face is re-evaluated whenever a
+    // corner changes): the next step's old shapes.
+    shape.copy_from_slice(new_shape);
     let mut halved = Vec::new();
     for (v, &h) in halvings.iter().enumerate() {
         if h as u32 > MAX_HALVINGS {
