@@ -468,6 +468,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         "hausdorff_first_frame": hausdorff[0],
         "hausdorff_last_frame": hausdorff[k_in - 1],
         "hausdorff_per_input": hausdorff,
+        "warnings": report::feature_warnings(align_rep.feature_points, align_rep.max_feature_gap_after, "rad"),
         "features": align_rep,
         "icp": icp_reports,
         "frames": params.frames,

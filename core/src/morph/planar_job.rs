@@ -279,6 +279,11 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
             "overlays": overlay_reps,
             "pseudo_metamesh": pseudo_reps,
             "common_boundary_vertices": common[0].bnd.iter().filter(|&&b| b != u32::MAX).count(),
+            "warnings": super::report::feature_warnings(
+                align_rep.feature_points,
+                align_rep.max_feature_gap_after,
+                "(unit-disk lengths)",
+            ),
             "features": align_rep,
             "icp": icp_reports,
             "repair": repair_reports,

@@ -60,3 +60,19 @@ pub fn relative_hausdorff(
     let diag = Aabb::of(pb).map(|b| b.diagonal()).unwrap_or(1.0).max(1e-300);
     d / diag
 }
+
+/// Largest feature gap (radians on the sphere, units of the unit disk in the plane) above which
+/// the report warns that the pairs did not meet.
+pub const FEATURE_GAP_WARN: f64 = 1e-6;
+
+/// The report's `warnings`: says when feature pairs were asked for but did not meet, so a stalled
+/// warp (it stops rather than fold the map) is not silent.
+pub fn feature_warnings(feature_points: usize, gap_after: f64, unit: &str) -> Vec<String> {
+    if feature_points == 0 || gap_after <= FEATURE_GAP_WARN {
+        return Vec::new();
+    }
+    vec![format!(
+        "feature pairs did not meet: the largest remaining gap is {gap_after:.3e} {unit} (the warp stops \
+         before it would fold the map; see features.warp_steps); try fewer or more consistent pairs"
+    )]
+}
