@@ -1,0 +1,228 @@
+//! The coarse stage: the user's pairs through an RBF (eq. 2.6–2.10), or PCA + ICP, and the RBF
+//! fit with its named errors and coplanar policy (shared with the fine stage).
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, sub, Aabb};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+use super::{align, curves, kdtree, rbf, Alignment, CoplanarCentres, FitPair, FitParams};
+
+/// What the coarse stage did (serialised into the report).
+#[derive(Debug, Clone, Serialize)]
+pub struct CoarseReport {
+    /// "pairs", "pca_icp" or "none".
+    pub method: &'static str,
+    /// Curve vertex each pair snapped to, per pair.
+    pub pair_curve_points: Vec<u32>,
+    pub pair_snap_distance_max: f64,
+    /// PCA + ICP final RMS distance of curve points to template vertices.
+    pub icp_rms: Option<f64>,
+}
+
+pub(super) fn coarse_alignment(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    params: &FitParams,
+    progress: &Progress,
+) -> Result<CoarseReport> {
+    let use_pairs = match params.alignment {
+        Alignment::Pairs => true,
+        Alignment::Auto => !params.pairs.is_empty(),
+        _ => false,
+    };
+    if use_pairs {
+        let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net)?;
+        let centres: Vec<Point3> = fixed.iter().map(|&(_, v)| pos[v as usize]).collect();
+        let values: Vec<Point3> =
+            fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
+        let name = |i: usize| format!("pairs[{i}] (template vertex {})", params.pairs[i].template_vertex);
+        let f = fit_rbf(
+            pos,
+            tris,
+            centres,
+            values,
+            &fixed.iter().map(|x| x.1).collect::<Vec<_>>(),
+            params,
+            "coarse",
+            "pairs",
+            &name,
+        )?;
+        let disp = f.eval_many(pos, progress)?;
+        for (p, d) in pos.iter_mut().zip(disp) {
+            *p = add(*p, d);
+        }
+        for &(p, v) in &fixed {
+            pos[v as usize] = net.points[p as usize];
+        }
+        return Ok(CoarseReport {
+            method: "pairs",
+            pair_curve_points: fixed.iter().map(|x| x.0).collect(),
+            pair_snap_distance_max: snap_max,
+            icp_rms: None,
+        });
+    }
+    if matches!(params.alignment, Alignment::None) {
+        return Ok(CoarseReport {
+            method: "none",
+            pair_curve_points: vec![],
+            pair_snap_distance_max: 0.0,
+            icp_rms: None,
+        });
+    }
+    let (sim, rms) = align::pca_icp(pos, &net.points, 30, progress)?;
+    for p in pos.iter_mut() {
+        *p = sim.apply(*p);
+    }
+    Ok(CoarseReport {
+        method: "pca_icp",
+        pair_curve_points: vec![],
+        pair_snap_distance_max: 0.0,
+        icp_rms: Some(rms),
+    })
+}
+
+/// Validates the pairs and snaps each curve point to its nearest curve vertex.
+fn snap_pairs(pairs: &[FitPair], nv: usize, net: &curves::CurveNetwork) -> Result<(Vec<(u32, u32)>, f64)> {
+    let tree = kdtree::KdTree::new(&net.points);
+    let mut out: Vec<(u32, u32)> = Vec::with_capacity(pairs.len());
+    let mut snap_max = 0.0f64;
+    for (i, p) in pairs.iter().enumerate() {
+        if p.template_vertex as usize >= nv {
+            return Err(Error::params(
+                format!("pairs[{i}].template_vertex"),
+                format!("vertex {} does not exist (the template has {nv} vertices)", p.template_vertex),
+            ));
+        }
+        if !p.curve_point.iter().all(|c| c.is_finite()) {
+            return Err(Error::params(format!("pairs[{i}].curve_point"), "coordinate is NaN or infinite"));
+        }
+        let (cp, d2) =
+            tree.nearest(p.curve_point).ok_or_else(|| Error::Internal("empty curve network".into()))?;
+        snap_max = snap_max.max(d2.sqrt());
+        if let Some(j) = out.iter().position(|&(_, v)| v == p.template_vertex) {
+            return Err(Error::params(
+                format!("pairs[{i}].template_vertex"),
+                format!("pairs[{j}] and pairs[{i}] use the same template vertex {}", p.template_vertex),
+            ));
+        }
+        if let Some(j) = out.iter().position(|&(c, _)| c == cp) {
+            return Err(Error::params(
+                format!("pairs[{i}].curve_point"),
+                format!("pairs[{j}] and pairs[{i}] snap to the same curve vertex {cp}"),
+            ));
+        }
+        out.push((cp, p.template_vertex));
+    }
+    Ok((out, snap_max))
+}
+
+/// RBF through the centres with the named-error checks and the coplanar policy.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fit_rbf(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    mut centres: Vec<Point3>,
+    mut values: Vec<Point3>,
+    centre_vertices: &[u32],
+    params: &FitParams,
+    stage: &str,
+    field: &str,
+    name: &dyn Fn(usize) -> String,
+) -> Result<rbf::Rbf> {
+    use rbf::Degenerate;
+    // The targets matter as much as the centres: template vertices picked near a straight or flat
+    // curve set are only *nearly* collinear/coplanar, which passes the exact check but leaves the
+    // affine part undetermined (the fit then explodes). So both sets are tested, with a looser
+    // threshold on the targets.
+    let targets: Vec<Point3> = centres.iter().zip(&values).map(|(c, v)| add(*c, *v)).collect();
+    let [flat, thin] = rbf::spread_ratios(&targets);
+    if centres.len() >= 4 && thin < 1e-3 {
+        return Err(Error::params(
+            field,
+            format!(
+                "the {} {stage} RBF targets lie on one line (spread ratio {thin:.1e}): a single straight curve \
+                 cannot define a deformation; add curves that span the surface",
+                centres.len()
+            ),
+        ));
+    }
+    let check = match rbf::check_centres(&centres) {
+        Ok(()) if centres.len() >= 4 && flat < 1e-3 => Err(Degenerate::Coplanar(flat)),
+        other => other,
+    };
+    match check {
+        Ok(()) => {}
+        Err(Degenerate::TooFew(n)) => {
+            return Err(Error::params(
+                field,
+                format!("the {stage} RBF needs at least 4 non-coplanar centres, got {n}"),
+            ))
+        }
+        Err(Degenerate::Duplicate(i, j)) => {
+            return Err(Error::params(
+                field,
+                format!(
+                "{} and {} are at the same position: duplicate RBF centres make the {stage} system singular",
+                name(i),
+                name(j)
+            ),
+            ))
+        }
+        Err(Degenerate::Coplanar(ratio)) => {
+            if params.coplanar_centres == CoplanarCentres::Reject {
+                return Err(Error::params(
+                    field,
+                    format!(
+                        "all {} {stage} RBF centres lie on one plane (spread ratio {ratio:.1e}): the system is singular; \
+                         give non-coplanar {field} or set coplanar_centres = \"augment\"",
+                        centres.len()
+                    ),
+                ));
+            }
+            augment(pos, tris, &mut centres, &mut values, centre_vertices);
+            if let Err(d) = rbf::check_centres(&centres) {
+                return Err(Error::params(
+                    field,
+                    format!("{stage} RBF centres stay degenerate after augmentation: {d:?}"),
+                ));
+            }
+        }
+    }
+    rbf::Rbf::fit(&centres, &values, params.kernel, stage)
+}
+
+/// Adds, for up to 8 spread-out centres, two points offset along the template vertex normal by
+/// ± 10% of the centres' extent, carrying the same displacement (they move rigidly with their base).
+fn augment(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    centres: &mut Vec<Point3>,
+    values: &mut Vec<Point3>,
+    centre_vertices: &[u32],
+) {
+    let n = centres.len();
+    let h = 0.1 * Aabb::of(centres).map(|b| b.diagonal()).unwrap_or(1.0);
+    let mut normal = vec![[0.0; 3]; pos.len()];
+    for t in tris {
+        let fnm = crate::geometry::triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+        for &v in t {
+            normal[v as usize] = add(normal[v as usize], fnm);
+        }
+    }
+    let k = n.min(8);
+    for j in 0..k {
+        let i = j * n / k;
+        let nm = crate::geometry::normalize(normal[centre_vertices[i] as usize]);
+        if nm == [0.0; 3] {
+            continue;
+        }
+        for sgn in [1.0, -1.0] {
+            centres.push(add(centres[i], crate::geometry::scale(nm, sgn * h)));
+            values.push(values[i]);
+        }
+    }
+}

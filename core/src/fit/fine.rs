@@ -1,0 +1,296 @@
+//! The fine stage: every curve vertex gets a template vertex (inserted at its foot, or the nearest
+//! one), the template approaches the curves, the exact RBF lands them, flips are handled.
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, dist, sub};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+use super::coarse::{fit_rbf, CoarseReport};
+use super::{approach, correspond, curves, flips, insert, FitParams, Matching};
+
+/// The fine stage's result.
+pub struct Fine {
+    pub positions: Vec<Point3>,
+    pub vertex_of_point: Vec<u32>,
+    pub report: FineReport,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FineReport {
+    pub rounds: u32,
+    pub correspondence_conflicts: usize,
+    pub correspondence_distance_max: f64,
+    pub correspondence_distance_mean: f64,
+    /// Faces flagged per round (flip counter ∪ orientation test).
+    pub flagged_per_round: Vec<usize>,
+    pub flagged_by_counter: usize,
+    pub flagged_by_orientation: usize,
+    /// Faces added by local subdivision.
+    pub faces_added: usize,
+    /// Faces still flipped by the last round (goal 0).
+    pub flipped_faces: usize,
+    pub augmented: bool,
+    /// "insert" or "nearest_vertex".
+    pub matching: &'static str,
+    /// What the insertion did (matching = insert).
+    pub insertion: Option<insert::InsertStats>,
+    /// Milliseconds per step of the fine stage (matching = insert): insert, solve, evaluate, flips.
+    pub steps_ms: Option<[f64; 4]>,
+    /// The multi-level approach to the curves before the exact fit (see [`approach`]).
+    pub approach: Option<approach::ApproachReport>,
+    pub approach_ms: f64,
+}
+
+/// Fails, naming the curve, when a curve vertex is farther than the limit from its template vertex.
+fn check_distances(
+    distances: &[f64],
+    net: &curves::CurveNetwork,
+    params: &FitParams,
+    template_diag: f64,
+) -> Result<()> {
+    let limit = params.max_curve_distance * template_diag;
+    if let Some((p, d)) = distances.iter().enumerate().find(|(_, &d)| d > limit) {
+        let c = net.curve_of_point[p];
+        return Err(Error::params(
+            "curves",
+            format!(
+                "curve {c}: its point {:?} is {d:.4} from the template, more than \
+                 max_curve_distance ({}) × the template's bounding-box diagonal ({template_diag:.4}) \
+                 after alignment; the curves do not lie on the template (check units, or give pairs)",
+                net.points[p], params.max_curve_distance
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The fine stage proper, by matching rule.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fine_dispatch(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    progress: &Progress,
+) -> Result<Fine> {
+    match params.matching {
+        Matching::Insert => {
+            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, progress)
+        }
+        Matching::NearestVertex => fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress),
+    }
+}
+
+/// The fine stage with `Matching::Insert`: split the template at the curve vertices' feet, solve
+/// the RBF once, and handle flips by subdividing the flagged faces under the *same* field (the
+/// centres never change, so only the new midpoints are evaluated: no re-solve per round).
+#[allow(clippy::too_many_arguments)]
+fn fine_fit_inserted(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    progress: &Progress,
+) -> Result<Fine> {
+    let pair_fixed: Vec<(u32, u32)> =
+        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let clock = std::time::Instant::now();
+    let mut steps_ms = [0.0; 4];
+    let mut lap = |k: usize| {
+        steps_ms[k] = clock.elapsed().as_secs_f64() * 1e3 - steps_ms.iter().sum::<f64>();
+    };
+    let before = tris.clone();
+    let nv0 = pos.len();
+    let ins =
+        insert::insert_curve_points(pos, tris, net, &pair_fixed, params.end_snap * template_diag, progress)?;
+    for c in &ins.created_in[nv0..] {
+        let (f, l) = c.ok_or_else(|| Error::Internal("inserted vertex without origin".into()))?;
+        let t = before[f as usize];
+        parents.push([(t[0], l[0]), (t[1], l[1]), (t[2], l[2])]);
+    }
+    drop(before);
+    let vop = ins.vertex_of_point.clone();
+    let distances: Vec<f64> = (0..vop.len()).map(|p| dist(net.points[p], pos[vop[p] as usize])).collect();
+    check_distances(&distances, net, params, template_diag)?;
+    let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
+    let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
+    let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
+    let before_aug = centres.len();
+    lap(0);
+    let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
+    lap(1);
+    let augmented = f.centre_count() > before_aug;
+    let disp = f.eval_many(pos, progress)?;
+    let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
+    for (p, &v) in vop.iter().enumerate() {
+        moved[v as usize] = net.points[p]; // exact, not RBF round-off
+    }
+    lap(2);
+    let mut scan = flips::detect(pos, &moved, tris);
+    let mut flagged_per_round = vec![scan.flipped.len()];
+    let (mut rounds, mut faces_added) = (1, 0);
+    let budget = tris.len() / 2;
+    while !scan.flipped.is_empty()
+        && rounds <= params.max_flip_iterations
+        && faces_added + 6 * scan.flipped.len() <= budget
+    {
+        progress.check()?;
+        let (p0, t0, par0) = (pos.len(), tris.clone(), parents.len());
+        let added = flips::subdivide(pos, tris, &scan.flipped, parents);
+        let d = f.eval_many(&pos[p0..], progress)?;
+        moved.extend(pos[p0..].iter().zip(d).map(|(p, d)| add(*p, d)));
+        let next = flips::detect(pos, &moved, tris);
+        flagged_per_round.push(next.flipped.len());
+        rounds += 1;
+        if next.flipped.len() >= scan.flipped.len() {
+            // No better under this field: undo the round (smaller faces fold the same way).
+            pos.truncate(p0);
+            moved.truncate(p0);
+            parents.truncate(par0);
+            *tris = t0;
+            break;
+        }
+        faces_added += added;
+        scan = next;
+    }
+    lap(3);
+    let n = distances.len().max(1) as f64;
+    Ok(Fine {
+        positions: moved,
+        vertex_of_point: vop,
+        report: FineReport {
+            rounds,
+            correspondence_conflicts: ins.stats.nudged,
+            correspondence_distance_max: distances.iter().cloned().fold(0.0, f64::max),
+            correspondence_distance_mean: distances.iter().sum::<f64>() / n,
+            flagged_per_round,
+            flagged_by_counter: scan.by_counter,
+            flagged_by_orientation: scan.by_orientation,
+            faces_added,
+            flipped_faces: scan.flipped.len(),
+            augmented,
+            matching: "insert",
+            insertion: Some(ins.stats),
+            steps_ms: Some(steps_ms),
+            approach: None,
+            approach_ms: 0.0,
+        },
+    })
+}
+
+/// The template's UVs extended to the vertices the fit added (each a weighted combination of
+/// older vertices, in creation order).
+pub fn interpolate_uvs(uv: &[[f64; 2]], parents: &[[(u32, f64); 3]]) -> Vec<[f64; 2]> {
+    let mut out = uv.to_vec();
+    out.reserve(parents.len());
+    for p in parents {
+        let mut u = [0.0; 2];
+        for &(v, w) in p {
+            let q = out[v as usize];
+            u[0] += w * q[0];
+            u[1] += w * q[1];
+        }
+        out.push(u);
+    }
+    out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn fine_fit(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    template_diag: f64,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    progress: &Progress,
+) -> Result<Fine> {
+    let pair_fixed: Vec<(u32, u32)> =
+        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let nv0 = pos.len() - parents.len();
+    let mut flagged_per_round = Vec::new();
+    let mut faces_added = 0;
+    let budget = tris.len(); // subdivision may at most double the face count
+    let mut best: Option<(Fine, Vec<Point3>, Vec<[u32; 3]>)> = None;
+    for round in 0..=params.max_flip_iterations {
+        progress.check()?;
+        let corr = correspond::closest(pos, net, &pair_fixed, progress)?;
+        check_distances(&corr.distances, net, params, template_diag)?;
+        let vop = corr.vertex_of_point.clone();
+        let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
+        let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
+        let name =
+            |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
+        let before_aug = centres.len();
+        let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
+        let augmented = f.centre_count() > before_aug;
+        let disp = f.eval_many(pos, progress)?;
+        let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
+        for (p, &v) in vop.iter().enumerate() {
+            moved[v as usize] = net.points[p]; // exact, not RBF round-off
+        }
+        let scan = flips::detect(pos, &moved, tris);
+        flagged_per_round.push(scan.flipped.len());
+        let n = corr.distances.len().max(1) as f64;
+        let flagged = scan.flipped.clone();
+        let fine = Fine {
+            positions: moved,
+            vertex_of_point: vop,
+            report: FineReport {
+                rounds: round + 1,
+                correspondence_conflicts: corr.conflicts,
+                correspondence_distance_max: corr.distances.iter().cloned().fold(0.0, f64::max),
+                correspondence_distance_mean: corr.distances.iter().sum::<f64>() / n,
+                flagged_per_round: Vec::new(),
+                flagged_by_counter: scan.by_counter,
+                flagged_by_orientation: scan.by_orientation,
+                faces_added,
+                flipped_faces: scan.flipped.len(),
+                augmented,
+                matching: "nearest_vertex",
+                insertion: None,
+                steps_ms: None,
+                approach: None,
+                approach_ms: 0.0,
+            },
+        };
+        // Keep the round with the fewest flips; a round that does not improve stops the loop
+        // (measured on homer: 52 → 23 → 37 → 98 → 375 flagged faces when it goes on, because the
+        // new, smaller faces fold in the same steep part of the field).
+        let matched_now = fine.vertex_of_point.clone();
+        let improves = best.as_ref().is_none_or(|b| fine.report.flipped_faces < b.0.report.flipped_faces);
+        if improves {
+            best = Some((fine, pos.clone(), tris.clone()));
+        }
+        let done = flagged.is_empty()
+            || !improves
+            || round == params.max_flip_iterations
+            || faces_added + 3 * flagged.len() * 2 > budget;
+        if done {
+            break;
+        }
+        // Subdivide the flagged faces and the stars of the matched vertices on them: a fold
+        // usually comes from a curve vertex matched to a template vertex a whole edge away, and
+        // the star's new edge midpoints give it a closer candidate in the next round.
+        let split = flips::with_matched_stars(tris, &flagged, &matched_now);
+        faces_added += flips::subdivide(pos, tris, &split, parents);
+    }
+    if let Some((mut fine, p, t)) = best {
+        parents.truncate(p.len() - nv0);
+        *pos = p;
+        *tris = t;
+        fine.report.flagged_per_round = flagged_per_round;
+        return Ok(fine);
+    }
+    Err(Error::Internal("flip loop ended without a result".into()))
+}
