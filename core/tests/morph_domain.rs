@@ -349,9 +349,8 @@ fn domain_disk_on_a_closed_mesh_is_refused() {
         msg.contains("input 0") && msg.contains("no boundary") && msg.contains("domain: sphere"),
         "{msg}"
     );
-    // A disk source with a closed target under auto: the target is named.
-    let msg = refusal(vec![paraboloid(6), shapes::icosphere(1, 1.0)], json!({"repair": true}));
-    assert!(msg.contains("input 1") && msg.contains("no boundary"), "{msg}");
+    // A disk source with a closed target under auto + repair is no longer refused: it goes to the
+    // sphere (auto_with_repair_closes_a_disk_whose_partner_is_closed).
 }
 
 #[test]
@@ -563,4 +562,20 @@ fn sphere_with_one_small_hole_is_a_disk_as_is_and_a_sphere_after_repair() {
         .fold(0.0, f64::max)
         / diag(&s.positions);
     assert!(d < 1e-9, "first frame vs icosphere {d}");
+}
+
+#[test]
+fn auto_with_repair_closes_a_disk_whose_partner_is_closed() {
+    // Input 0 is a disk by the rim rule, input 1 a closed sphere: no disk domain fits both, so the
+    // auto rule goes spherical (the hemisphere's rim is closed) instead of refusing input 1.
+    let sphere = shapes::icosphere(3, 1.0);
+    let o = morph(vec![hemisphere(), sphere.clone()], json!({"frames": 2, "repair": true}));
+    assert_eq!(o.report["domain"], "spherical");
+    let why = o.report["domain_reason"].as_str().unwrap();
+    assert!(why.contains("input 1") && why.contains("closed"), "{why}");
+    // The first frame is the closed hemisphere: no boundary edge left.
+    assert!(boundary_edges(&o.meshes[0]).is_empty());
+    // Without repair the rule is unchanged: input 0 (a disk) decides and the sphere is refused.
+    let msg = refusal(vec![hemisphere(), sphere], json!({"frames": 2}));
+    assert!(msg.contains("disk"), "{msg}");
 }

@@ -222,7 +222,20 @@ pub fn prepare(
             MorphDomain::Disk => (Chosen::Planar, "requested by `domain: disk`".to_string()),
             MorphDomain::Auto => {
                 let (d, why) = rim_rule(&measure_loops(&cleaned[0].mesh));
-                (d, format!("auto with repair: input 0 after cleaning has {why}"))
+                // A closed input cannot become a disk, so a disk-like input 0 with a closed partner
+                // goes to the sphere (its rim is closed) rather than refusing the partner.
+                let closed = cleaned.iter().position(|c| measure_loops(&c.mesh).is_empty());
+                match (d, closed) {
+                    (Chosen::Planar, Some(k)) => (
+                        Chosen::Spherical,
+                        format!(
+                            "auto with repair: input 0 after cleaning has {why}; but {} is closed, so \
+                             every input is closed into a sphere",
+                            input_name(k)
+                        ),
+                    ),
+                    _ => (d, format!("auto with repair: input 0 after cleaning has {why}")),
+                }
             }
         };
         // 3. Fill holes for that domain.
