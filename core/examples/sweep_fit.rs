@@ -7,6 +7,7 @@
 //!
 //! Run from the repository root:
 //! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example sweep_fit [NAME…]`
+//! (`SWEEP_FAILED=1` also prints the report's list of segments that could not be made edge chains.)
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -133,6 +134,9 @@ fn main() {
                 Ok(out) => {
                     let r = &out.report;
                     let inside = ends_inside(&out.meshes[0]);
+                    if std::env::var("SWEEP_FAILED").is_ok() {
+                        eprintln!("{name} {label}: {}", r["retriangulation"]["failed"]);
+                    }
                     println!(
                         "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>8.2} {:>4}/{:<4} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
                         template.positions.len(),
