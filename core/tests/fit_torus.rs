@@ -6,11 +6,9 @@
 //! - the number of regions the planes cut the torus into, counted on a finer torus by the side of
 //!   every plane (connected components of faces with the same side code).
 
-use std::collections::HashMap;
-
 use meshwork_core::fit::kdtree::KdTree;
 use meshwork_core::fit::smooth::closest_on_triangle;
-use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
+use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_regions, plane_sections, thin_network};
 use meshwork_core::fit::{run, FitParams};
 use meshwork_core::geometry::{dist, dot, triangle_cross, Aabb};
 use meshwork_core::mesh::Point3;
@@ -32,51 +30,10 @@ fn planes() -> Vec<(Point3, f64)> {
     ]
 }
 
-/// Regions of the torus minus the planes, counted on a fine torus: faces entirely on one side of
-/// every plane, grouped by side code and connected through shared edges.
+/// Regions of the torus minus the planes, counted on a fine torus (faces entirely on one side of
+/// every plane, grouped by side code and connected through shared edges).
 fn expected_regions(planes: &[(Point3, f64)]) -> usize {
-    let m = torus(384, 160, R, RMINOR, false);
-    let tris = fan_triangles(&m.faces);
-    let code = |p: Point3| -> u32 {
-        planes.iter().enumerate().map(|(k, (n, o))| ((dot(*n, p) > *o) as u32) << k).sum()
-    };
-    let codes: Vec<Option<u32>> = tris
-        .iter()
-        .map(|t| {
-            let c: Vec<u32> = t.iter().map(|&v| code(m.positions[v as usize])).collect();
-            (c[0] == c[1] && c[1] == c[2]).then_some(c[0])
-        })
-        .collect();
-    let mut edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edge.entry((a.min(b), a.max(b))).or_default().push(f);
-        }
-    }
-    let mut seen = vec![false; tris.len()];
-    let mut count = 0;
-    for s in 0..tris.len() {
-        if seen[s] || codes[s].is_none() {
-            continue;
-        }
-        count += 1;
-        seen[s] = true;
-        let mut stack = vec![s];
-        while let Some(f) = stack.pop() {
-            let t = tris[f];
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                for &g in &edge[&(a.min(b), a.max(b))] {
-                    if !seen[g] && codes[g] == codes[f] {
-                        seen[g] = true;
-                        stack.push(g);
-                    }
-                }
-            }
-        }
-    }
-    count
+    plane_regions(&torus(384, 160, R, RMINOR, false), planes)
 }
 
 /// Distance from each point to a triangle mesh: closest point over the faces around the 4 mesh

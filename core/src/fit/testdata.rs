@@ -216,10 +216,14 @@ pub fn crossing_pairs(
 }
 
 /// Regions a set of planes cuts a surface into (the truth for section networks), counted on a
-/// 4×-subdivided copy: faces grouped by the side
-/// of every plane, connected through shared edges; faces cut by a plane are left out.
+/// 4×-subdivided copy (see [`plane_regions`]).
 pub fn section_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
-    let fine = subdivide_midpoint(m, 2);
+    plane_regions(&subdivide_midpoint(m, 2), planes)
+}
+
+/// Regions of `fine` minus the planes: faces grouped by the side of every plane, connected through
+/// shared edges; faces cut by a plane are left out (so `fine` must be much finer than the regions).
+pub fn plane_regions(fine: &Mesh, planes: &[(Point3, f64)]) -> usize {
     let tris = fan_triangles(&fine.faces);
     let side = |p: Point3| {
         planes.iter().enumerate().fold(0u32, |c, (k, (n, o))| c | (((dot(*n, p) - o) > 0.0) as u32) << k)

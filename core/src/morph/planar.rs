@@ -173,22 +173,11 @@ pub fn arc_length_angles(pos: &[Point3], lp: &[u32]) -> Vec<f64> {
 /// Solves the interior of the spring system with the boundary fixed at `angles`.
 fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod) -> Result<Vec<Point3>> {
     let n = m.pos.len();
-    let mut plane = vec![[0.0, 0.0, 1.0]; n];
-    let mut is_bnd = vec![false; n];
+    let mut at = vec![[0.0; 2]; n];
+    let mut fixed = vec![false; n];
     for (&v, &a) in lp.iter().zip(angles) {
-        is_bnd[v as usize] = true;
-        plane[v as usize] = lift(a.cos(), a.sin());
-    }
-    let mut free = vec![u32::MAX; n];
-    let mut nf = 0u32;
-    for v in 0..n {
-        if !is_bnd[v] {
-            free[v] = nf;
-            nf += 1;
-        }
-    }
-    if nf == 0 {
-        return Ok(plane);
+        fixed[v as usize] = true;
+        at[v as usize] = [a.cos(), a.sin()];
     }
     let edges = m.edges();
     let mean_len = edges.iter().map(|&(a, b)| dist(m.pos[a as usize], m.pos[b as usize])).sum::<f64>()
@@ -203,12 +192,35 @@ fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod)
             }
         }
     };
-    let nf = nf as usize;
+    solve_springs(&mut at, &fixed, edges.iter().map(|&(a, b)| (a, b, weight(a, b))))?;
+    Ok(at.iter().map(|p| lift(p[0], p[1])).collect())
+}
+
+/// The weighted spring (Dirichlet) system of a planar layout: every vertex with `fixed[v]` stays
+/// at `at[v]`, every other lands at the weighted mean of its neighbours. `edges` lists each
+/// undirected edge once with its weight (> 0). Both coordinates from one Cholesky factorisation;
+/// shared by the disk maps here and the sphere fallback's Tutte layout.
+pub(super) fn solve_springs(
+    at: &mut [[f64; 2]],
+    fixed: &[bool],
+    edges: impl IntoIterator<Item = (u32, u32, f64)>,
+) -> Result<()> {
+    let n = at.len();
+    let mut free = vec![u32::MAX; n];
+    let mut nf = 0usize;
+    for v in 0..n {
+        if !fixed[v] {
+            free[v] = nf as u32;
+            nf += 1;
+        }
+    }
+    if nf == 0 {
+        return Ok(());
+    }
     let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nf];
     let mut diag = vec![0.0; nf];
     let mut rhs = vec![0.0; 2 * nf];
-    for &(a, b) in &edges {
-        let w = weight(a, b);
+    for (a, b, w) in edges {
         for (i, j) in [(a, b), (b, a)] {
             let fi = free[i as usize];
             if fi == u32::MAX {
@@ -217,7 +229,7 @@ fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod)
             diag[fi as usize] += w;
             let fj = free[j as usize];
             if fj == u32::MAX {
-                let p = plane[j as usize];
+                let p = at[j as usize];
                 rhs[fi as usize] += w * p[0];
                 rhs[nf + fi as usize] += w * p[1];
             } else {
@@ -229,10 +241,10 @@ fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod)
     let mut col = Vec::new();
     let mut val = Vec::new();
     row_ptr.push(0u32);
-    for i in 0..nf {
-        rows[i].push((i as u32, diag[i]));
-        rows[i].sort_unstable_by_key(|e| e.0);
-        for &(j, w) in &rows[i] {
+    for (i, row) in rows.iter_mut().enumerate() {
+        row.push((i as u32, diag[i]));
+        row.sort_unstable_by_key(|e| e.0);
+        for &(j, w) in row.iter() {
             col.push(j);
             val.push(w);
         }
@@ -245,10 +257,10 @@ fn solve_interior(m: &TriMesh, lp: &[u32], angles: &[f64], method: PlanarMethod)
     for v in 0..n {
         let f = free[v];
         if f != u32::MAX {
-            plane[v] = lift(rhs[f as usize], rhs[nf + f as usize]);
+            at[v] = [rhs[f as usize], rhs[nf + f as usize]];
         }
     }
-    Ok(plane)
+    Ok(())
 }
 
 /// The disk map of a disk-topology mesh (counter-clockwise faces), with the embedding check and

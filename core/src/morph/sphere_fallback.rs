@@ -30,9 +30,7 @@
 use crate::error::{Error, Result};
 use crate::geometry::{corner_angle, dist, triangle_area};
 use crate::job::Progress;
-use crate::laplacian::Csr;
 use crate::mesh::Point3;
-use crate::solve::Cholesky;
 
 use super::param::{self, distortion};
 use super::simplify::Hierarchy;
@@ -361,63 +359,9 @@ fn tutte_layout(mesh: &TriMesh, v0: u32, link: &[u32], weights: TutteWeights) ->
     let clamp =
         |x: f64| if x.is_finite() && x > 0.0 { x.clamp(1e-6 * mean, 1e6 * mean) } else { 1e-6 * mean };
 
-    let mut free = vec![u32::MAX; n];
-    let mut nf = 0usize;
-    for v in 0..n {
-        if !fixed[v] {
-            free[v] = nf as u32;
-            nf += 1;
-        }
-    }
-    if nf == 0 {
-        return Ok(plane);
-    }
-    let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nf];
-    let mut diag = vec![0.0; nf];
-    let mut rhs = vec![0.0; 2 * nf];
     let mut edges: Vec<((u32, u32), f64)> = w.into_iter().collect();
     edges.sort_unstable_by_key(|e| e.0);
-    for ((a, b), x) in edges {
-        let x = clamp(x);
-        for (i, j) in [(a, b), (b, a)] {
-            let fi = free[i as usize];
-            if fi == u32::MAX {
-                continue;
-            }
-            diag[fi as usize] += x;
-            let fj = free[j as usize];
-            if fj == u32::MAX {
-                let p = plane[j as usize];
-                rhs[fi as usize] += x * p[0];
-                rhs[nf + fi as usize] += x * p[1];
-            } else {
-                rows[fi as usize].push((fj, -x));
-            }
-        }
-    }
-    let mut row_ptr = Vec::with_capacity(nf + 1);
-    let mut col = Vec::new();
-    let mut val = Vec::new();
-    row_ptr.push(0u32);
-    for (i, row) in rows.iter_mut().enumerate() {
-        row.push((i as u32, diag[i]));
-        row.sort_unstable_by_key(|e| e.0);
-        for &(j, x) in row.iter() {
-            col.push(j);
-            val.push(x);
-        }
-        row_ptr.push(col.len() as u32);
-    }
-    let a = Csr { n: nf, row_ptr, col, val };
-    let mut chol = Cholesky::analyze(&a)?;
-    chol.factor(&a)?;
-    chol.solve_in_place(&mut rhs, 2)?;
-    for v in 0..n {
-        let f = free[v];
-        if f != u32::MAX {
-            plane[v] = [rhs[f as usize], rhs[nf + f as usize]];
-        }
-    }
+    super::planar::solve_springs(&mut plane, &fixed, edges.into_iter().map(|((a, b), x)| (a, b, clamp(x))))?;
     Ok(plane)
 }
 
