@@ -287,25 +287,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
     })?;
 
     // Feature vertices, mapped to the triangulated inputs.
-    let mut features: Vec<Vec<u32>> = Vec::with_capacity(params.features.len());
-    for (i, f) in params.features.iter().enumerate() {
-        let mut row = Vec::with_capacity(k_in);
-        for k in 0..k_in {
-            let v = f[k] as usize;
-            let m = maps[k].get(v).copied().unwrap_or(u32::MAX);
-            if m == u32::MAX {
-                return Err(Error::params(
-                    format!("features[{i}][{k}]"),
-                    format!(
-                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
-                        input_name(k)
-                    ),
-                ));
-            }
-            row.push(m);
-        }
-        features.push(row);
-    }
+    let features = map_features(&params.features, &maps, k_in)?;
 
     // 2. Normalise.
     let (normalised, frames_out, icp_reports) =
@@ -518,4 +500,28 @@ pub(crate) fn normalise(
         }
     }
     Ok((norm, frames, icp))
+}
+
+/// Feature vertices (input indices) mapped to the triangulated inputs.
+fn map_features(features: &[Vec<u32>], maps: &[Vec<u32>], k_in: usize) -> Result<Vec<Vec<u32>>> {
+    let mut out = Vec::with_capacity(features.len());
+    for (i, f) in features.iter().enumerate() {
+        let mut row = Vec::with_capacity(k_in);
+        for k in 0..k_in {
+            let v = f[k] as usize;
+            let m = maps[k].get(v).copied().unwrap_or(u32::MAX);
+            if m == u32::MAX {
+                return Err(Error::params(
+                    format!("features[{i}][{k}]"),
+                    format!(
+                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
+                        input_name(k)
+                    ),
+                ));
+            }
+            row.push(m);
+        }
+        out.push(row);
+    }
+    Ok(out)
 }

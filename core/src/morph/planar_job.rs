@@ -98,7 +98,7 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
         }
         Ok((ms, maps, convs, topo))
     })?;
-    let features = map_features(&params.features, &maps, k_in)?;
+    let features = super::map_features(&params.features, &maps, k_in)?;
 
     // 2. Normalise (as the spherical path), then orient each disk's normal to +z.
     let (normalised, frames_out, icp_reports, flipped) = stages.run(progress, "normalise", || {
@@ -296,30 +296,6 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
         }
         Output { meshes, artifacts, report }
     })
-}
-
-/// Feature vertices (input indices) mapped to the triangulated inputs.
-fn map_features(features: &[Vec<u32>], maps: &[Vec<u32>], k_in: usize) -> Result<Vec<Vec<u32>>> {
-    let mut out = Vec::with_capacity(features.len());
-    for (i, f) in features.iter().enumerate() {
-        let mut row = Vec::with_capacity(k_in);
-        for k in 0..k_in {
-            let v = f[k] as usize;
-            let m = maps[k].get(v).copied().unwrap_or(u32::MAX);
-            if m == u32::MAX {
-                return Err(Error::params(
-                    format!("features[{i}][{k}]"),
-                    format!(
-                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
-                        input_name(k)
-                    ),
-                ));
-            }
-            row.push(m);
-        }
-        out.push(row);
-    }
-    Ok(out)
 }
 
 fn meshes_len(m: &TriMesh) -> usize {
