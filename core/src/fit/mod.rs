@@ -151,6 +151,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
+    let fine_parents = parents.len();
     parents.extend_from_slice(&realised.added);
     // Vertices split into crossed edges take the reference normal of their edge.
     for a in &realised.added {
@@ -235,6 +236,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
     };
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
+    let flipped_before_smoothing = untangle::count_flipped(&mesh.pos, &out_tris, &reference_normals);
     let mut out_pos = mesh.pos.clone();
     let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
@@ -249,6 +251,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
         })?;
     }
+    // Smoothed vertices slid over the surface: their UVs are read where they now are.
+    let smooth_uv_moves =
+        if params.smooth && template.uvs.is_some() { uvs::relocate(&mesh, &out_pos) } else { Vec::new() };
     // Smoothing moves free vertices by tangential steps that can fold a face in a tight spot: the
     // same untangling, against the same reference, on the smoothed positions.
     let untangle_smoothed = if params.smooth {
@@ -305,8 +310,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     }
     let mut out = Mesh::new(out_pos, faces);
     out.uvs = template.uvs.as_ref().map(|uv| {
-        let mut uvs = interpolate_uvs(uv, &parents);
+        // In the order the vertices were made and moved: fine-stage splits, fine untangling,
+        // re-triangulation splits and moves, its untangling, smoothing, the last untangling.
+        let mut uvs = interpolate_uvs(uv, &parents[..fine_parents]);
+        uvs::apply_batches(&mut uvs, &untangle_fine.uv_batches);
+        let mut uvs = interpolate_uvs(&uvs, &parents[fine_parents..]);
         uvs::apply(&mut uvs, &realised.uv_moves);
+        uvs::apply_batches(&mut uvs, &untangle_retri.uv_batches);
+        uvs::apply_batches(&mut uvs, std::slice::from_ref(&smooth_uv_moves));
+        if let Some(s) = &untangle_smoothed {
+            uvs::apply_batches(&mut uvs, &s.uv_batches);
+        }
         keep.vec(&uvs)
     });
     out.groups = group_names;
@@ -347,6 +361,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "segments_as_edges": quality.segments_as_edges,
         "flipped_faces": quality.flipped_faces,
         "flipped_faces_after_fine": fine.report.flipped_faces,
+        "flipped_faces_before_smoothing": flipped_before_smoothing,
         "cleanup": cleaned,
         "moved_vertices": realised.uv_moves.iter().map(|m| m.vertex).collect::<Vec<_>>(),
         "smoothing": smoothing,
