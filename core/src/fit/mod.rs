@@ -254,6 +254,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Smoothed vertices slid over the surface: their UVs are read where they now are.
     let smooth_uv_moves =
         if params.smooth && template.uvs.is_some() { uvs::relocate(&mesh, &out_pos) } else { Vec::new() };
+    let smooth_moved: Vec<u32> =
+        (0..out_pos.len() as u32).filter(|&v| out_pos[v as usize] != mesh.pos[v as usize]).collect();
     // Smoothing moves free vertices by tangential steps that can fold a face in a tight spot: the
     // same untangling, against the same reference, on the smoothed positions.
     let untangle_smoothed = if params.smooth {
@@ -337,6 +339,15 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &reference_normals,
         ))
     })?;
+    // Every vertex moved over the surface (its UV re-read where it landed), in the numbering
+    // before the clean-up: re-triangulation snaps, untangling, smoothing.
+    let mut moved_vertices: Vec<u32> = realised.uv_moves.iter().map(|m| m.vertex).collect();
+    for s in [Some(&untangle_fine), Some(&untangle_retri), untangle_smoothed.as_ref()].into_iter().flatten() {
+        moved_vertices.extend(s.uv_batches.iter().flatten().map(|m| m.vertex));
+    }
+    moved_vertices.extend_from_slice(&smooth_moved);
+    moved_vertices.sort_unstable();
+    moved_vertices.dedup();
     let report = serde_json::json!({
         "template_vertices": template.vertex_count(),
         "template_faces": template.face_count(),
@@ -363,7 +374,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "flipped_faces_after_fine": fine.report.flipped_faces,
         "flipped_faces_before_smoothing": flipped_before_smoothing,
         "cleanup": cleaned,
-        "moved_vertices": realised.uv_moves.iter().map(|m| m.vertex).collect::<Vec<_>>(),
+        "moved_vertices": moved_vertices,
         "smoothing": smoothing,
         "min_angle_deg_after_retriangulation": angles_retri.min_deg,
         "mean_min_angle_deg_after_retriangulation": angles_retri.mean_min_deg,
