@@ -197,6 +197,176 @@ pub fn pca_icp(
     )))
 }
 
+/// What the smooth warp of [`warp_icp`] did (serialised into the report).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct WarpReport {
+    /// Iterations run per degree (affine, then quadratic).
+    pub iterations: [u32; 2],
+    /// Trimmed RMS distance of the curve points to the surface before and after the warp.
+    pub rms_before: f64,
+    pub rms_after: f64,
+    /// Iterations whose step was halved because the full step folded faces.
+    pub damped: u32,
+}
+
+/// Monomials of degree ≤ 2 of `u` (1, u, v, w, u², v², w², uv, vw, wu); `degree` 1 keeps 4.
+fn monomials(u: Point3, degree: usize) -> ([f64; 10], usize) {
+    let m =
+        [1.0, u[0], u[1], u[2], u[0] * u[0], u[1] * u[1], u[2] * u[2], u[0] * u[1], u[1] * u[2], u[2] * u[0]];
+    (m, if degree >= 2 { 10 } else { 4 })
+}
+
+/// Solves the symmetric positive definite `n×n` system `a x = b` (3 right-hand sides) by
+/// Cholesky; `None` when it is not positive definite.
+fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Option<Vec<[f64; 3]>> {
+    let mut l = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            let s: f64 = a[i * n + j] - (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum::<f64>();
+            if i == j {
+                if s <= 0.0 || !s.is_finite() {
+                    return None;
+                }
+                l[i * n + i] = s.sqrt();
+            } else {
+                l[i * n + j] = s / l[j * n + j];
+            }
+        }
+    }
+    let mut y = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for c in 0..3 {
+            y[i][c] = (b[i][c] - (0..i).map(|k| l[i * n + k] * y[k][c]).sum::<f64>()) / l[i * n + i];
+        }
+    }
+    let mut x = vec![[0.0; 3]; n];
+    for i in (0..n).rev() {
+        for c in 0..3 {
+            x[i][c] = (y[i][c] - (i + 1..n).map(|k| l[k * n + i] * x[k][c]).sum::<f64>()) / l[i * n + i];
+        }
+    }
+    Some(x)
+}
+
+/// Smooth non-rigid alignment after the similarity ICP: ICP with an affine, then a quadratic
+/// polynomial warp of the whole template (x ↦ x + Σ cₖ mₖ((x − centre)/radius)).
+///
+/// Why: a similarity cannot follow a target that is a stretched or bent copy of the template, and
+/// the closest-point steps after it (approach levels, fine fit) only correct the *normal* distance
+/// of each curve point to the surface: the tangential error a similarity leaves (measured on the
+/// bent sweep meshes: 3–4× the error left by a coarse RBF through 12 user pairs) stays, and the
+/// fine displacements are then large compared with the edges, which folds faces. A global warp
+/// with few parameters is stiff, so iterating closest points moves it tangentially too (the shape
+/// of the curve network pins it), which a sparse interpolating RBF cannot do.
+///
+/// Guards: matches farther than 2.5× the median are trimmed; every coefficient is pulled towards
+/// zero by a ridge term, the quadratic ones harder, so directions the curves do not determine
+/// (all curves on one plane) stay put; a step that would fold faces is halved (then stops).
+pub fn warp_icp(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    points: &[Point3],
+    iterations: u32,
+    progress: &Progress,
+) -> Result<WarpReport> {
+    let mut report = WarpReport::default();
+    if points.len() < 10 || tris.is_empty() {
+        return Ok(report);
+    }
+    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(f as u32);
+        }
+    }
+    // A spread subset keeps each iteration cheap on dense networks.
+    let stride = (points.len() / 1500).max(1);
+    let which: Vec<u32> = (0..points.len() as u32).step_by(stride).collect();
+    let centre = mean(points);
+    let radius = (points.iter().map(|p| norm2(sub(*p, centre))).sum::<f64>() / points.len() as f64).sqrt();
+    if !(radius > 0.0) {
+        return Ok(report);
+    }
+    let u = |p: Point3| scale(sub(p, centre), 1.0 / radius);
+    let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
+        let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
+        d.sort_by(f64::total_cmp);
+        let cut = 2.5 * d[d.len() / 2];
+        let keep: Vec<usize> = (0..feet.len()).filter(|&i| feet[i].2 <= cut.max(1e-300)).collect();
+        let rms =
+            (keep.iter().map(|&i| feet[i].2 * feet[i].2).sum::<f64>() / keep.len().max(1) as f64).sqrt();
+        (keep, rms)
+    };
+    let mut first = true;
+    for (stage, degree) in [1usize, 2].into_iter().enumerate() {
+        let mut last_rms = f64::INFINITY;
+        for _ in 0..iterations {
+            progress.check()?;
+            let feet = super::insert::feet(pos, tris, &vf, points, &which)?;
+            let (keep, rms) = trimmed(&feet);
+            if first {
+                report.rms_before = rms;
+                first = false;
+            }
+            report.rms_after = rms;
+            if rms > 0.999 * last_rms || keep.len() < 10 {
+                break;
+            }
+            last_rms = rms;
+            report.iterations[stage] += 1;
+            let n = monomials([0.0; 3], degree).1;
+            let mut a = vec![0.0; n * n];
+            let mut b = vec![[0.0; 3]; n];
+            for &i in &keep {
+                let (m, _) = monomials(u(feet[i].1), degree);
+                let r = sub(points[which[i] as usize], feet[i].1);
+                for j in 0..n {
+                    for k in 0..n {
+                        a[j * n + k] += m[j] * m[k];
+                    }
+                    for c in 0..3 {
+                        b[j][c] += m[j] * r[c];
+                    }
+                }
+            }
+            // Ridge: light on the affine part, 10× on the quadratic part (relative to the count).
+            let w = keep.len() as f64;
+            for j in 0..n {
+                a[j * n + j] += if j < 4 { 1e-3 * w } else { 1e-2 * w };
+            }
+            let Some(coef) = solve_spd(&a, &b, n) else { break };
+            let disp: Vec<Point3> = pos
+                .iter()
+                .map(|&p| {
+                    let (m, _) = monomials(u(p), degree);
+                    let mut d = [0.0; 3];
+                    for j in 0..n {
+                        d = add(d, scale(coef[j], m[j]));
+                    }
+                    d
+                })
+                .collect();
+            let mut step = 1.0;
+            let moved = loop {
+                let moved: Vec<Point3> =
+                    pos.iter().zip(&disp).map(|(p, d)| add(*p, scale(*d, step))).collect();
+                if super::approach::folds(pos, &moved, tris) == 0 {
+                    break Some(moved);
+                }
+                report.damped += 1;
+                step *= 0.5;
+                if step < 0.2 {
+                    break None;
+                }
+            };
+            let Some(moved) = moved else { break };
+            pos.copy_from_slice(&moved);
+        }
+    }
+    report.rms_after = trimmed(&super::insert::feet(pos, tris, &vf, points, &which)?).1;
+    Ok(report)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,7 +20,12 @@ pub struct CoarseReport {
     pub pair_snap_distance_max: f64,
     /// PCA + ICP final RMS distance of curve points to template vertices.
     pub icp_rms: Option<f64>,
+    /// The smooth (affine, then quadratic) warp fitted after the ICP (`pca_icp` only).
+    pub warp: Option<align::WarpReport>,
 }
+
+/// Iterations per degree of the smooth warp after the ICP (each: one closest-point pass).
+const WARP_ITERATIONS: u32 = 30;
 
 pub(super) fn coarse_alignment(
     pos: &mut [Point3],
@@ -63,6 +68,7 @@ pub(super) fn coarse_alignment(
             pair_curve_points: fixed.iter().map(|x| x.0).collect(),
             pair_snap_distance_max: snap_max,
             icp_rms: None,
+            warp: None,
         });
     }
     if matches!(params.alignment, Alignment::None) {
@@ -71,17 +77,20 @@ pub(super) fn coarse_alignment(
             pair_curve_points: vec![],
             pair_snap_distance_max: 0.0,
             icp_rms: None,
+            warp: None,
         });
     }
     let (sim, rms) = align::pca_icp(pos, &net.points, 30, progress)?;
     for p in pos.iter_mut() {
         *p = sim.apply(*p);
     }
+    let warp = align::warp_icp(pos, tris, &net.points, WARP_ITERATIONS, progress)?;
     Ok(CoarseReport {
         method: "pca_icp",
         pair_curve_points: vec![],
         pair_snap_distance_max: 0.0,
         icp_rms: Some(rms),
+        warp: Some(warp),
     })
 }
 

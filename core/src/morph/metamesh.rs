@@ -14,41 +14,14 @@
 //! Overlays chain: the result is again a spherical triangulation carrying one 3D shape per input,
 //! which is how 3+ inputs are merged (multi-morph).
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use crate::error::{Error, Result};
 use crate::geometry::{add, cross, dot, normalize, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::correspond::{bary_on_chord, interpolate, Locator};
+use super::face_pairs::{walk_face_pairs, FxMap, PolygonFans};
 use super::param::orient;
-
-/// FxHash (rustc's hasher): the overlay hashes millions of small integer labels, where SipHash's
-/// DoS resistance buys nothing and costs most of the stage's time.
-#[derive(Default)]
-struct Fx(u64);
-impl Hasher for Fx {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
-        }
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-}
-type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<Fx>>;
 
 /// A spherical triangulation carrying one 3D position per vertex for each input shape.
 #[derive(Clone, Debug)]
@@ -151,11 +124,11 @@ impl Ord for Angle {
     }
 }
 
-fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
+pub(super) fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
     add(a, scale(sub(b, a), t))
 }
 
-fn canon(u: u32, v: u32) -> (u32, u32) {
+pub(super) fn canon(u: u32, v: u32) -> (u32, u32) {
     (u.min(v), u.max(v))
 }
 
@@ -173,113 +146,78 @@ pub struct OverlayReport {
 pub fn overlay(a: &Layer, b: &Layer, progress: &Progress) -> Result<(Layer, OverlayReport)> {
     let nbr_b = super::trimesh::TriMesh { pos: b.sphere.clone(), tris: b.tris.clone() }.face_neighbours();
     let mut loc = Locator::new(&b.sphere, &b.tris, nbr_b.clone());
-    let mut ids: FxMap<Label, u32> =
-        FxMap::with_capacity_and_hasher((a.sphere.len() + b.sphere.len()) * 3, Default::default());
+    let mut fans = PolygonFans::with_capacity((a.sphere.len() + b.sphere.len()) * 3);
     let mut sphere: Vec<Point3> = Vec::new();
     let ka = a.shapes.len();
     let mut shapes: Vec<Vec<Point3>> = vec![Vec::new(); ka + b.shapes.len()];
-    let mut tris: Vec<[u32; 3]> = Vec::new();
     let mut rep = OverlayReport::default();
-    let mut hint = 0u32;
-    let mut corners: Vec<(Label, Point3, u32, u32)> = Vec::with_capacity(12);
-    let mut queue: Vec<u32> = Vec::new();
-    let mut seen: Vec<u32> = Vec::new();
+    let mut corners: Vec<(Label, Point3)> = Vec::with_capacity(12);
     let (sa, sb) = (&a.sphere[..], &b.sphere[..]);
-    for (fa, ta) in a.tris.iter().enumerate() {
-        if fa % 8192 == 0 {
-            progress.fraction(fa as f64 / a.tris.len() as f64)?;
+    let centre =
+        |ta: [u32; 3]| normalize(add(add(sa[ta[0] as usize], sa[ta[1] as usize]), sa[ta[2] as usize]));
+    rep.empty_pairs = walk_face_pairs(&a.tris, &nbr_b, &mut loc, progress, centre, |fa, fb| {
+        let (ta, tb) = (a.tris[fa], b.tris[fb as usize]);
+        pair_corners(sa, ta, sb, tb, &mut corners);
+        if corners.len() < 3 {
+            return corners.len();
         }
-        let ta = *ta;
-        let centre = normalize(add(add(sa[ta[0] as usize], sa[ta[1] as usize]), sa[ta[2] as usize]));
-        let seed = loc.locate(centre, hint);
-        hint = seed;
-        queue.clear();
-        seen.clear();
-        queue.push(seed);
-        seen.push(seed);
-        let mut qi = 0;
-        while qi < queue.len() {
-            let fb = queue[qi];
-            qi += 1;
-            let tb = b.tris[fb as usize];
-            corners.clear();
-            for &v in &ta {
-                if inside(sb, tb, sa[v as usize]) {
-                    corners.push((Label::A(v), sa[v as usize], fa as u32, fb));
+        // Order the corners around the polygon's centre (it is convex). The angular sort goes
+        // counter-clockwise about c (e1 × e2 = c), the faces' orientation.
+        let c = normalize(corners.iter().fold([0.0; 3], |s, x| add(s, x.1)));
+        let e1 =
+            normalize(if c[0].abs() < 0.9 { cross(c, [1.0, 0.0, 0.0]) } else { cross(c, [0.0, 1.0, 0.0]) });
+        let e2 = cross(c, e1);
+        corners.sort_by_cached_key(|x| Angle(pseudo_angle(dot(x.1, e1), dot(x.1, e2))));
+        fans.add(
+            &corners,
+            |x| x.0,
+            |&(label, p)| {
+                sphere.push(p);
+                push_shapes(&mut shapes, ka, a, b, label, p, fa as u32, fb);
+                if matches!(label, Label::X(..)) {
+                    rep.crossings += 1;
                 }
-            }
-            for &v in &tb {
-                if inside(sa, ta, sb[v as usize]) {
-                    corners.push((Label::B(v), sb[v as usize], fa as u32, fb));
-                }
-            }
-            for i in 0..3 {
-                let (a0, a1) = canon(ta[i], ta[(i + 1) % 3]);
-                for j in 0..3 {
-                    let (b0, b1) = canon(tb[j], tb[(j + 1) % 3]);
-                    if crosses(sa, a0, a1, sb, b0, b1) {
-                        let p = crossing_point(
-                            sa[a0 as usize],
-                            sa[a1 as usize],
-                            sb[b0 as usize],
-                            sb[b1 as usize],
-                        );
-                        corners.push((Label::X(a0, a1, b0, b1), p, fa as u32, fb));
-                    }
-                }
-            }
-            let nonempty = corners.len() >= 3;
-            if nonempty || qi == 1 {
-                for &g in &nbr_b[fb as usize] {
-                    if g != u32::MAX && !seen.contains(&g) {
-                        seen.push(g);
-                        queue.push(g);
-                    }
-                }
-            }
-            if !nonempty {
-                if !corners.is_empty() {
-                    rep.empty_pairs += 1;
-                }
-                continue;
-            }
-            // Order the corners around the polygon's centre (it is convex).
-            let c = normalize(corners.iter().fold([0.0; 3], |s, x| add(s, x.1)));
-            let e1 = normalize(if c[0].abs() < 0.9 {
-                cross(c, [1.0, 0.0, 0.0])
-            } else {
-                cross(c, [0.0, 1.0, 0.0])
-            });
-            let e2 = cross(c, e1);
-            corners.sort_by_cached_key(|x| Angle(pseudo_angle(dot(x.1, e1), dot(x.1, e2))));
-            let mut poly: Vec<u32> = Vec::with_capacity(corners.len());
-            for &(label, p, fa_, fb_) in corners.iter() {
-                let id = match ids.get(&label) {
-                    Some(&id) => id,
-                    None => {
-                        let id = sphere.len() as u32;
-                        ids.insert(label, id);
-                        sphere.push(p);
-                        push_shapes(&mut shapes, ka, a, b, label, p, fa_, fb_);
-                        if matches!(label, Label::X(..)) {
-                            rep.crossings += 1;
-                        }
-                        id
-                    }
-                };
-                poly.push(id);
-            }
-            // The angular sort goes counter-clockwise about c (e1 × e2 = c), the faces' orientation.
-            for k in 1..poly.len() - 1 {
-                tris.push([poly[0], poly[k], poly[k + 1]]);
+            },
+        );
+        corners.len()
+    })?;
+    rep.vertices = sphere.len();
+    rep.faces = fans.tris.len();
+    let layer = Layer { sphere, tris: fans.tris, shapes };
+    check_closed_manifold(&layer.tris, layer.sphere.len())?;
+    Ok((layer, rep))
+}
+
+/// The corners of the intersection of A-face `ta` and B-face `tb` (unordered): A-vertices inside
+/// the B-face, B-vertices inside the A-face, A-edges crossing B-edges.
+fn pair_corners(
+    sa: &[Point3],
+    ta: [u32; 3],
+    sb: &[Point3],
+    tb: [u32; 3],
+    corners: &mut Vec<(Label, Point3)>,
+) {
+    corners.clear();
+    for &v in &ta {
+        if inside(sb, tb, sa[v as usize]) {
+            corners.push((Label::A(v), sa[v as usize]));
+        }
+    }
+    for &v in &tb {
+        if inside(sa, ta, sb[v as usize]) {
+            corners.push((Label::B(v), sb[v as usize]));
+        }
+    }
+    for i in 0..3 {
+        let (a0, a1) = canon(ta[i], ta[(i + 1) % 3]);
+        for j in 0..3 {
+            let (b0, b1) = canon(tb[j], tb[(j + 1) % 3]);
+            if crosses(sa, a0, a1, sb, b0, b1) {
+                let p = crossing_point(sa[a0 as usize], sa[a1 as usize], sb[b0 as usize], sb[b1 as usize]);
+                corners.push((Label::X(a0, a1, b0, b1), p));
             }
         }
     }
-    rep.vertices = sphere.len();
-    rep.faces = tris.len();
-    let layer = Layer { sphere, tris, shapes };
-    check_closed_manifold(&layer.tris, layer.sphere.len())?;
-    Ok((layer, rep))
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -20,6 +20,7 @@
 pub mod align;
 pub mod correspond;
 pub mod domain;
+mod face_pairs;
 pub mod glb;
 pub mod interpolate;
 pub mod metamesh;

@@ -1,0 +1,103 @@
+//! Automatic alignment (no user pairs) on a real template: the target is a known non-rigid bend
+//! (`testdata::bend`) of the template, so every template vertex has a true position. Truths used:
+//! the bent positions, the best similarity to them (Horn, fitted to the *true* correspondences: no
+//! rigid alignment can do better), and the region count of the plane sections (counted on a finer
+//! copy by `testdata::section_regions`, independent of the fit).
+
+use meshwork_core::fit::curves::CurveNetwork;
+use meshwork_core::fit::testdata::{bend, plane_sections, section_regions, thin_network};
+use meshwork_core::fit::{align, run, FitParams};
+use meshwork_core::geometry::{dist, Aabb};
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
+use meshwork_core::Progress;
+
+/// A shared mesh, scaled so its longest side is 1 with the min corner at 0 (as the fit sweep).
+fn shared(name: &str) -> Mesh {
+    let dir = env!("CARGO_MANIFEST_DIR");
+    let bytes =
+        [format!("{dir}/../../shared/meshes/{name}.obj"), format!("{dir}/../../../shared/meshes/{name}.obj")]
+            .iter()
+            .find_map(|p| std::fs::read(p).ok())
+            .expect("mesh in ../shared/meshes");
+    let mut m = read(&bytes, &ReadOptions::default()).expect("read").mesh;
+    let bb = Aabb::of(&m.positions).unwrap();
+    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] = (p[k] - bb.min[k]) / side;
+        }
+    }
+    m
+}
+
+/// Four sections across the longest axis, one along each other axis (off round offsets).
+fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
+    let bb = Aabb::of(&m.positions).unwrap();
+    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
+    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap();
+    let axis = |k: usize| {
+        let mut n = [0.0; 3];
+        n[k] = 1.0;
+        n
+    };
+    let mut p: Vec<(Point3, f64)> =
+        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
+    for k in (0..3).filter(|&k| k != long) {
+        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
+    }
+    p
+}
+
+fn rms(a: &[Point3], b: &[Point3]) -> f64 {
+    (a.iter().zip(b).map(|(p, q)| dist(*p, *q).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+}
+
+/// Bent sections of `m` (every second section point kept).
+fn bent_sections(m: &Mesh) -> Mesh {
+    let mut curves = thin_network(&plane_sections(m, &planes(m)), 2);
+    for p in &mut curves.positions {
+        *p = bend(*p, 1.0);
+    }
+    curves
+}
+
+#[test]
+fn automatic_alignment_follows_a_bend_better_than_any_similarity() {
+    let m = shared("spot");
+    let truth: Vec<Point3> = m.positions.iter().map(|&p| bend(p, 1.0)).collect();
+    let net = CurveNetwork::from_mesh(&bent_sections(&m), 1e-6).unwrap();
+    let tris = fan_triangles(&m.faces);
+    // The best similarity with the true correspondences: a floor for any rigid alignment.
+    let oracle = align::fit_similarity(&m.positions, &truth);
+    let floor = rms(&m.positions.iter().map(|&p| oracle.apply(p)).collect::<Vec<_>>(), &truth);
+
+    let mut pos = m.positions.clone();
+    let (sim, _) = align::pca_icp(&pos, &net.points, 30, &Progress::new()).unwrap();
+    for p in &mut pos {
+        *p = sim.apply(*p);
+    }
+    let rigid = rms(&pos, &truth);
+    let w = align::warp_icp(&mut pos, &tris, &net.points, 30, &Progress::new()).unwrap();
+    let warped = rms(&pos, &truth);
+    eprintln!("similarity floor {floor:.4}, ICP {rigid:.4}, warp {warped:.4} ({w:?})");
+    assert!(rigid < 1.5 * floor, "the ICP lands near the best similarity: {rigid} vs {floor}");
+    assert!(warped < 0.5 * floor, "the warp follows the bend beyond any similarity: {warped} vs {floor}");
+    assert!(w.rms_after < 0.2 * w.rms_before, "curve points end on the surface: {w:?}");
+}
+
+#[test]
+fn automatic_alignment_fit_finds_every_region() {
+    let m = shared("spot");
+    let expected = section_regions(&m, &planes(&m));
+    let template = subdivide_midpoint(&m, 1);
+    let params = FitParams::default(); // no pairs: PCA + ICP + warp
+    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let r = &out.report;
+    eprintln!("alignment {}", r["alignment"]);
+    assert_eq!(r["alignment"]["method"], "pca_icp");
+    assert_eq!(r["flipped_faces"], 0);
+    assert_eq!(r["segments_as_edges"].as_f64(), Some(1.0));
+    assert_eq!(r["regions"].as_u64(), Some(expected as u64), "regions vs the planes' count");
+}
