@@ -29,6 +29,8 @@ use crate::mesh::Point3;
 use super::curves::CurveNetwork;
 use super::trimesh::{IntHasher, IntMap, TriMesh};
 
+mod route;
+
 type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
 
 #[derive(Debug, Clone, Default, Serialize)]
@@ -44,10 +46,20 @@ pub struct RetriStats {
     /// split instead, and the vertices that added.
     pub split_segments: usize,
     pub split_vertices: usize,
-    /// Segments that needed the Dijkstra-and-project fallback.
+    /// Segments (or their rest after a partial walk) realised by the Dijkstra-and-project fallback
+    /// (§3.2), taken only when moving its path onto the segment turns no face over.
     pub fallback_segments: usize,
     /// Vertices the fallback moved onto a segment.
     pub fallback_moved_vertices: usize,
+    /// Dijkstra paths found but not taken because projecting them would turn a face over.
+    pub fallback_refused_flips: usize,
+    /// Segments realised by the route across faces made a chain by edge splits ([`route`]), the
+    /// vertices the splits added and how many of those could then move onto the segment.
+    pub route_segments: usize,
+    pub route_vertices: usize,
+    pub route_vertices_on_segment: usize,
+    /// Which fallback realised which segment (the first 50).
+    pub fallbacks: Vec<FallbackUse>,
     /// Segments that could not be realised at all.
     pub failed_segments: usize,
     /// Why walks stopped (one count per failed walk piece).
@@ -71,6 +83,41 @@ pub struct FailedSegment {
     pub stopped_at: u32,
     /// "start", "boundary", "curve_edge", "lost" or "fill".
     pub walk: &'static str,
+    /// Why the route fallback found no way: "separated" (curve edges realised earlier separate the
+    /// ends on the surface: crossing or tangled input, no chain exists without crossing a curve) or
+    /// "budget" (search limit reached).
+    pub route: &'static str,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FallbackUse {
+    pub segment: usize,
+    /// "dijkstra" or "route".
+    pub method: &'static str,
+    /// Vertices moved (dijkstra) or added (route) for this segment.
+    pub vertices: usize,
+    /// Length of the chain the fallback made over the straight distance of its ends: well above
+    /// 1 when realised curves block the straight way (crossing or tangled input) and the chain
+    /// goes around them.
+    pub detour: f64,
+}
+
+/// How a fallback realised a segment.
+enum Fallback {
+    Dijkstra(usize),
+    Route(usize),
+}
+
+/// Chain length over end-to-end distance.
+fn detour(mesh: &TriMesh, chain: &[u32]) -> f64 {
+    let (Some(&a), Some(&b)) = (chain.first(), chain.last()) else { return 1.0 };
+    let len: f64 = chain.windows(2).map(|p| mesh.len(p[0], p[1])).sum();
+    let d = mesh.len(a, b);
+    if d > 0.0 {
+        len / d
+    } else {
+        1.0
+    }
 }
 
 pub struct Realised {
@@ -88,6 +135,23 @@ pub struct Realised {
 }
 
 impl RetriStats {
+    fn record_fallback(&mut self, segment: usize, how: Fallback, detour: f64) {
+        let (method, vertices) = match how {
+            Fallback::Dijkstra(n) => {
+                self.fallback_segments += 1;
+                self.fallback_moved_vertices += n;
+                ("dijkstra", n)
+            }
+            Fallback::Route(n) => {
+                self.route_segments += 1;
+                self.route_vertices += n;
+                ("route", n)
+            }
+        };
+        if self.fallbacks.len() < 50 {
+            self.fallbacks.push(FallbackUse { segment, method, vertices, detour });
+        }
+    }
     fn clone_counts(&self) -> [usize; 5] {
         [
             self.walk_fail_start,
@@ -163,9 +227,13 @@ pub fn realise(
     let mut chains = Vec::with_capacity(net.segments.len());
     let mut added = Vec::new();
     let mut uv_moves = Vec::new();
+    // Segments whose walk failed, with why: their fallbacks run after every walk, so a route
+    // (which may leave the straight line) sees all the walked chains and cannot pass on the wrong
+    // side of a curve vertex whose own segments are yet to come.
+    let mut pending: Vec<(usize, &'static str)> = Vec::new();
     for (si, seg) in net.segments.iter().enumerate() {
         if si % 256 == 0 {
-            progress.fraction(si as f64 / net.segments.len().max(1) as f64)?;
+            progress.fraction(0.8 * si as f64 / net.segments.len().max(1) as f64)?;
         }
         let (u, w) = (vertex_of_point[seg[0] as usize], vertex_of_point[seg[1] as usize]);
         let mut chain = vec![u];
@@ -189,40 +257,151 @@ pub fn realise(
             if ok {
                 stats.walked += 1;
             } else {
-                // Fallback from wherever the walk stopped.
-                let from = *chain.last().unwrap_or(&u);
-                match dijkstra_project(mesh, from, w, &on_curve, &mut uv_moves) {
-                    Some(path) => {
-                        stats.fallback_segments += 1;
-                        stats.fallback_moved_vertices += path.len().saturating_sub(2);
-                        for &v in &path[1..] {
-                            on_curve[v as usize] = true;
-                            chain.push(v);
-                        }
-                    }
-                    None => {
-                        if stats.failed.len() < 20 {
-                            let walk = stats.fail_reason_since(before);
-                            stats.failed.push(FailedSegment {
-                                segment: si,
-                                points: *seg,
-                                vertices: [u, w],
-                                stopped_at: from,
-                                walk,
-                            });
-                        }
-                        stats.failed_segments += 1;
-                        chain.push(w);
-                    }
-                }
+                pending.push((si, stats.fail_reason_since(before)));
             }
         }
-        for p in chain.windows(2) {
-            locked_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
-        }
+        lock_chain(&mut locked_edges, &chain);
         chains.push(chain);
     }
+    for (k, &(si, walk)) in pending.iter().enumerate() {
+        if k % 64 == 0 {
+            progress.fraction(0.8 + 0.2 * k as f64 / pending.len() as f64)?;
+        }
+        let seg = net.segments[si];
+        let (u, w) = (vertex_of_point[seg[0] as usize], vertex_of_point[seg[1] as usize]);
+        // From wherever the walk stopped: the seed's Dijkstra-and-project when it turns no face
+        // over, else the route across faces made a chain by edge splits.
+        let mut chain = std::mem::take(&mut chains[si]);
+        let from = *chain.last().unwrap_or(&u);
+        let seg_ends = (mesh.pos[u as usize], mesh.pos[w as usize]);
+        let n0 = chain.len();
+        let method = fallback(
+            mesh,
+            from,
+            w,
+            seg_ends,
+            &mut on_curve,
+            &locked_edges,
+            &mut chain,
+            &mut added,
+            &mut stats,
+            &mut uv_moves,
+        );
+        match method {
+            Ok(m) => {
+                stats.record_fallback(si, m, detour(mesh, &chain[n0 - 1..]));
+                lock_chain(&mut locked_edges, &chain[n0 - 1..]);
+            }
+            Err(why) => {
+                if stats.failed.len() < 20 {
+                    stats.failed.push(FailedSegment {
+                        segment: si,
+                        points: seg,
+                        vertices: [u, w],
+                        stopped_at: from,
+                        walk,
+                        route: match why {
+                            route::NoRoute::Separated => "separated",
+                            route::NoRoute::Budget => "budget",
+                        },
+                    });
+                }
+                stats.failed_segments += 1;
+                chain.push(w);
+            }
+        }
+        chains[si] = chain;
+    }
     Ok(Realised { chains, on_curve, added, stats, uv_moves })
+}
+
+fn lock_chain(locked: &mut EdgeSet, chain: &[u32]) {
+    for p in chain.windows(2) {
+        locked.insert((p[0].min(p[1]), p[0].max(p[1])));
+    }
+}
+
+/// Largest number of faces the route fallback settles for one segment.
+const ROUTE_BUDGET: usize = 1_000_000;
+
+/// Realises the rest of a segment from `from` (the last chain vertex) to `to` after a failed
+/// walk: Dijkstra-and-project when it turns no face over, else the route across faces split into
+/// a chain. Pushes the chain after `from` including `to`.
+#[allow(clippy::too_many_arguments)]
+fn fallback(
+    mesh: &mut TriMesh,
+    from: u32,
+    to: u32,
+    seg: (Point3, Point3),
+    on_curve: &mut Vec<bool>,
+    locked_edges: &EdgeSet,
+    chain: &mut Vec<u32>,
+    added: &mut Vec<[(u32, f64); 3]>,
+    stats: &mut RetriStats,
+    uv_moves: &mut Vec<super::uvs::UvMove>,
+) -> std::result::Result<Fallback, route::NoRoute> {
+    match dijkstra_project(mesh, from, to, on_curve, uv_moves) {
+        Projected::Done(path) => {
+            for &v in &path[1..] {
+                on_curve[v as usize] = true;
+                chain.push(v);
+            }
+            return Ok(Fallback::Dijkstra(path.len().saturating_sub(2)));
+        }
+        Projected::WouldFlip => stats.fallback_refused_flips += 1,
+        Projected::NoPath => {}
+    }
+    let crossings = route::find(mesh, from, to, seg, locked_edges, ROUTE_BUDGET)?;
+    let n0 = chain.len();
+    if !split_crossings(mesh, &crossings, on_curve, added, chain) {
+        // Cannot happen for a route of distinct faces (each split leaves the next edge in place);
+        // kept as a named failure rather than a panic.
+        return Err(route::NoRoute::Budget);
+    }
+    // The split points lie on the surface; each moves onto the straight segment where that turns
+    // no face of its star over (against the normals before any move).
+    let new: Vec<u32> = chain[n0..].to_vec();
+    let mut before: IntMap<u32, Point3> = IntMap::default();
+    for &m in &new {
+        for &f in mesh.faces_of(m) {
+            before.insert(f, mesh.face_normal(f));
+        }
+    }
+    for &m in &new {
+        let target = closest_on_segment(mesh.pos[m as usize], seg.0, seg.1);
+        if keeps_orientation(mesh, m, target, |f| before.get(&f).copied()) {
+            uv_moves.extend(super::uvs::record(mesh, m, target));
+            mesh.pos[m as usize] = target;
+            stats.route_vertices_on_segment += 1;
+        }
+    }
+    chain.push(to);
+    Ok(Fallback::Route(new.len()))
+}
+
+fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 { (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    add(a, scale(ab, t))
+}
+
+/// Would moving `z` to `target` keep every face of its star turned the way `reference` says
+/// (the face's current normal when `reference` has none) and of non-negligible area?
+fn keeps_orientation(
+    mesh: &TriMesh,
+    z: u32,
+    target: Point3,
+    reference: impl Fn(u32) -> Option<Point3>,
+) -> bool {
+    mesh.faces_of(z).iter().all(|&f| {
+        let t = mesh.tris[f as usize];
+        let p = |v: u32| if v == z { target } else { mesh.pos[v as usize] };
+        let n0 = mesh.face_normal(f);
+        let r = reference(f).unwrap_or(n0);
+        let n1 = cross(sub(p(t[1]), p(t[0])), sub(p(t[2]), p(t[0])));
+        dot(r, n1) > 0.0 && dot(n0, n1) > 0.0 && norm(n1) > 1e-12 * norm(n0)
+    })
 }
 
 /// Walks and re-triangulates from u to w, possibly in pieces at snapped vertices. Pushes chain
@@ -328,13 +507,7 @@ fn snappable(mesh: &TriMesh, cut: &Cut, z: u32, on_curve: &[bool]) -> bool {
     if tz <= 0.0 || tz >= cut.len {
         return false;
     }
-    mesh.faces_of(z).iter().all(|&f| {
-        let t = mesh.tris[f as usize];
-        let p = |v: u32| if v == z { target } else { mesh.pos[v as usize] };
-        let n0 = mesh.face_normal(f);
-        let n1 = cross(sub(p(t[1]), p(t[0])), sub(p(t[2]), p(t[0])));
-        dot(n0, n1) > 0.0 && norm(n1) > 1e-12 * norm(n0)
-    })
+    keeps_orientation(mesh, z, target, |_| None)
 }
 
 fn walk(
@@ -417,8 +590,9 @@ fn walk(
     Walk::Fail(FailReason::Lost)
 }
 
-/// Splits every crossed edge (l, r) of a strip where the cut plane crosses it, pushing the new vertices onto `chain`. False if an edge is no longer there (nothing else done
-/// for it; the chain stays valid up to its last vertex).
+/// Splits every crossed edge (l, r) of a strip where the cut plane crosses it, pushing the new
+/// vertices onto `chain`. False if an edge is no longer there (nothing else done for it; the chain
+/// stays valid up to its last vertex).
 fn split_strip(
     mesh: &mut TriMesh,
     cut: &Cut,
@@ -427,12 +601,27 @@ fn split_strip(
     added: &mut Vec<[(u32, f64); 3]>,
     chain: &mut Vec<u32>,
 ) -> bool {
-    for &(l, r) in crossed {
-        let (c, lam) = crossing(mesh, cut, l, r);
-        // At the crossing itself (on the surface): moving it onto the straight segment would fold
-        // the split faces where the strip is long and curved.
-        let Some(m) = split_edge(mesh, l, r, c) else { return false };
-        added.push([(l, 1.0 - lam), (r, lam), (l, 0.0)]);
+    // At the crossing itself (on the surface): moving it onto the straight segment would fold
+    // the split faces where the strip is long and curved.
+    let crossings: Vec<route::Crossing> =
+        crossed.iter().map(|&(l, r)| route::Crossing { l, r, lam: crossing(mesh, cut, l, r).1 }).collect();
+    split_crossings(mesh, &crossings, on_curve, added, chain)
+}
+
+/// Splits each crossed edge in order at its fraction, pushing the new vertices onto `chain`
+/// (consecutive crossings of one face become an edge between their new vertices).
+fn split_crossings(
+    mesh: &mut TriMesh,
+    crossings: &[route::Crossing],
+    on_curve: &mut Vec<bool>,
+    added: &mut Vec<[(u32, f64); 3]>,
+    chain: &mut Vec<u32>,
+) -> bool {
+    for c in crossings {
+        let (pl, pr) = (mesh.pos[c.l as usize], mesh.pos[c.r as usize]);
+        let x = add(pl, scale(sub(pr, pl), c.lam));
+        let Some(m) = split_edge(mesh, c.l, c.r, x) else { return false };
+        added.push([(c.l, 1.0 - c.lam), (c.r, c.lam), (c.l, 0.0)]);
         on_curve.push(true);
         chain.push(m);
     }
@@ -604,15 +793,30 @@ fn ear_cut(mesh: &TriMesh, poly: &[u32], origin: Point3, e1: Point3, e2: Point3)
     Some(out)
 }
 
+enum Projected {
+    Done(Vec<u32>),
+    /// A path exists but projecting it would turn a face over (nothing was moved).
+    WouldFlip,
+    NoPath,
+}
+
 /// §3.2 fallback: shortest edge path from `from` to `to` through free vertices, whose inner
-/// vertices are then moved onto the segment (spaced by their arc length along the path).
+/// vertices are then moved onto the segment (spaced by their arc length along the path), unless
+/// that turns a face of their stars over.
 fn dijkstra_project(
     mesh: &mut TriMesh,
     from: u32,
     to: u32,
     on_curve: &[bool],
     uv_moves: &mut Vec<super::uvs::UvMove>,
-) -> Option<Vec<u32>> {
+) -> Projected {
+    match dijkstra_path(mesh, from, to, on_curve) {
+        None => Projected::NoPath,
+        Some((path, total)) => project_path(mesh, path, total, uv_moves),
+    }
+}
+
+fn dijkstra_path(mesh: &TriMesh, from: u32, to: u32, on_curve: &[bool]) -> Option<(Vec<u32>, f64)> {
     let mut dist: IntMap<u32, f64> = IntMap::default();
     let mut prev: IntMap<u32, u32> = IntMap::default();
     let mut heap = BinaryHeap::new();
@@ -656,6 +860,16 @@ fn dijkstra_project(
         path.push(v);
     }
     path.reverse();
+    Some((path, total))
+}
+
+fn project_path(
+    mesh: &mut TriMesh,
+    path: Vec<u32>,
+    total: f64,
+    uv_moves: &mut Vec<super::uvs::UvMove>,
+) -> Projected {
+    let (from, to) = (path[0], path[path.len() - 1]);
     let (a, b) = (mesh.pos[from as usize], mesh.pos[to as usize]);
     let mut acc = 0.0;
     let old: Vec<Point3> = path.iter().map(|&v| mesh.pos[v as usize]).collect();
@@ -664,14 +878,34 @@ fn dijkstra_project(
         acc += crate::geometry::dist(old[k - 1], old[k]);
         let frac = if total > 0.0 { acc / total } else { 0.5 };
         let target = add(a, scale(sub(b, a), frac));
-        // Located on the mesh before any path vertex moves.
-        uv_moves.extend(super::uvs::record(mesh, path[k], target));
         targets.push(target);
     }
-    for (k, target) in targets.into_iter().enumerate() {
-        mesh.pos[path[k + 1] as usize] = target;
+    let inner = &path[1..path.len().saturating_sub(1)];
+    let mut stars: Vec<u32> = inner.iter().flat_map(|&v| mesh.faces_of(v).iter().copied()).collect();
+    stars.sort_unstable();
+    stars.dedup();
+    let normals: Vec<Point3> = stars.iter().map(|&f| mesh.face_normal(f)).collect();
+    for (&v, &t) in inner.iter().zip(&targets) {
+        mesh.pos[v as usize] = t;
     }
-    Some(path)
+    let turned = stars.iter().zip(&normals).any(|(&f, &n0)| {
+        let n1 = mesh.face_normal(f);
+        dot(n0, n1) <= 0.0 || norm(n1) <= 1e-12 * norm(n0)
+    });
+    for (&v, &p) in inner.iter().zip(&old[1..]) {
+        mesh.pos[v as usize] = p;
+    }
+    if turned {
+        return Projected::WouldFlip;
+    }
+    // Located on the mesh before any path vertex moves.
+    for (&v, &t) in inner.iter().zip(&targets) {
+        uv_moves.extend(super::uvs::record(mesh, v, t));
+    }
+    for (&v, t) in inner.iter().zip(targets) {
+        mesh.pos[v as usize] = t;
+    }
+    Projected::Done(path)
 }
 
 #[cfg(test)]
@@ -723,5 +957,116 @@ mod tests {
             let p = add(scale(mesh.pos[a[0].0 as usize], a[0].1), scale(mesh.pos[a[1].0 as usize], a[1].1));
             assert!(crate::geometry::dist(p, mesh.pos[6 + i]) < 1e-12);
         }
+    }
+
+    /// The n × n unit grid of triangles in z = 0 (vertex (i, j) = j(n+1) + i at (i, j, 0)).
+    fn grid_mesh(n: usize) -> TriMesh {
+        let g = crate::shapes::grid(n, n, 1.0, false);
+        TriMesh::new(g.positions, crate::shapes::fan_triangles(&g.faces)).unwrap()
+    }
+
+    fn all_up(mesh: &TriMesh) -> bool {
+        mesh.alive_faces().all(|f| mesh.face_normal(f)[2] > 0.0)
+    }
+
+    /// Where the polyline through `chain` crosses the line x = x0 (all the y values).
+    fn crossings_at_x(mesh: &TriMesh, chain: &[u32], x0: f64) -> Vec<f64> {
+        chain
+            .windows(2)
+            .filter_map(|w| {
+                let (p, q) = (mesh.pos[w[0] as usize], mesh.pos[w[1] as usize]);
+                if (p[0] - x0) * (q[0] - x0) > 0.0 || p[0] == q[0] {
+                    return None;
+                }
+                let t = (x0 - p[0]) / (q[0] - p[0]);
+                Some(p[1] + t * (q[1] - p[1]))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn route_goes_around_a_curve_wall_and_splits_into_a_chain() {
+        // A wall of curve edges on x = 5 from y = 3 to y = 7 between u = (2, 5) and w = (8, 5):
+        // any chain from u to w must pass x = 5 at y ≤ 3 or y ≥ 7 (hand truth), and the splits
+        // add 2 faces per crossed edge and turn none over.
+        let n = 10;
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut mesh = grid_mesh(n);
+        let mut locked = EdgeSet::default();
+        lock_chain(&mut locked, &(3..=7).map(|j| id(5, j)).collect::<Vec<_>>());
+        let (u, w) = (id(2, 5), id(8, 5));
+        let seg = (mesh.pos[u as usize], mesh.pos[w as usize]);
+        let crossings = route::find(&mesh, u, w, seg, &locked, 10_000).expect("a route exists");
+        let faces0 = mesh.live_triangles().len();
+        let (mut on_curve, mut added, mut chain) = (vec![false; mesh.pos.len()], Vec::new(), vec![u]);
+        assert!(split_crossings(&mut mesh, &crossings, &mut on_curve, &mut added, &mut chain));
+        chain.push(w);
+        assert_eq!(mesh.live_triangles().len(), faces0 + 2 * crossings.len());
+        assert!(all_up(&mesh));
+        for p in chain.windows(2) {
+            assert!(mesh.has_edge(p[0], p[1]), "{p:?} is not an edge");
+            assert!(!locked.contains(&(p[0].min(p[1]), p[0].max(p[1]))));
+        }
+        // Only new vertices between the ends: the chain passes through no old vertex.
+        assert!(chain[1..chain.len() - 1].iter().all(|&v| v as usize > id(n, n) as usize));
+        let ys = crossings_at_x(&mesh, &chain, 5.0);
+        assert!(!ys.is_empty() && ys.iter().all(|&y| y <= 3.0 + 1e-9 || y >= 7.0 - 1e-9), "{ys:?}");
+    }
+
+    #[test]
+    fn route_reports_ends_separated_by_a_closed_curve() {
+        // w = (5, 5) inside a closed loop of curve edges around it: no chain from (1, 1) exists.
+        let n = 10;
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mesh = grid_mesh(n);
+        let mut locked = EdgeSet::default();
+        let ring = [(4, 4), (5, 4), (6, 4), (6, 5), (6, 6), (5, 6), (4, 6), (4, 5), (4, 4)];
+        lock_chain(&mut locked, &ring.iter().map(|&(i, j)| id(i, j)).collect::<Vec<_>>());
+        let (u, w) = (id(1, 1), id(5, 5));
+        let seg = (mesh.pos[u as usize], mesh.pos[w as usize]);
+        assert_eq!(route::find(&mesh, u, w, seg, &locked, 10_000), Err(route::NoRoute::Separated));
+    }
+
+    #[test]
+    fn realise_makes_a_blocked_segment_a_chain_around_the_block() {
+        // Curve 0: the wall x = 5, y = 3..7 through grid vertices; curve 1: one segment from (2, 5)
+        // to (8, 6) across it (crossing input: the straight way is blocked by the wall's edges).
+        // The walk stops at the wall; the fallback must still give an edge chain, around the wall
+        // (so at least 2·√(3² + 2²) − long, hand bound: detour ≥ 7.2 / √37 ≈ 1.18).
+        let n = 10;
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut mesh = grid_mesh(n);
+        let mut pts: Vec<Point3> = (3..=7).map(|j| mesh.pos[id(5, j) as usize]).collect();
+        pts.push(mesh.pos[id(2, 5) as usize]);
+        pts.push(mesh.pos[id(8, 6) as usize]);
+        let curves = crate::mesh::Mesh {
+            positions: pts.clone(),
+            curves: vec![vec![0, 1, 2, 3, 4], vec![5, 6]],
+            ..Default::default()
+        };
+        let net = CurveNetwork::from_mesh(&curves, 1e-9).unwrap();
+        let vop: Vec<u32> = net
+            .points
+            .iter()
+            .map(|p| (0..mesh.pos.len() as u32).find(|&v| mesh.pos[v as usize] == *p).unwrap())
+            .collect();
+        let r = realise(&mut mesh, &net, &vop, 0.2, &Progress::new()).unwrap();
+        assert_eq!(r.stats.failed_segments, 0, "{:?}", r.stats.failed);
+        for c in &r.chains {
+            for p in c.windows(2) {
+                assert!(mesh.has_edge(p[0], p[1]), "{p:?} is not an edge");
+            }
+        }
+        assert!(all_up(&mesh));
+        let blocked = net
+            .segments
+            .iter()
+            .position(|s| vop[s[0] as usize] == id(2, 5) || vop[s[1] as usize] == id(2, 5))
+            .unwrap();
+        let used: Vec<_> = r.stats.fallbacks.iter().filter(|f| f.segment == blocked).collect();
+        assert_eq!(used.len(), 1);
+        assert!(used[0].detour >= 7.2 / 37f64.sqrt(), "{}", used[0].detour);
+        let ys = crossings_at_x(&mesh, &r.chains[blocked], 5.0);
+        assert!(!ys.is_empty() && ys.iter().all(|&y| y <= 3.0 + 1e-9 || y >= 7.0 - 1e-9), "{ys:?}");
     }
 }
