@@ -63,8 +63,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         return Err(Error::params("inputs", "fit takes exactly two meshes: template, curves"));
     };
     let mut stages = Stages::new();
-    let net = stages
-        .run(progress, "curves", || curves::CurveNetwork::from_mesh(&curve_mesh, params.join_tolerance))?;
+    let net = stages.run(progress, "curves", || {
+        let options = curves::NetworkOptions {
+            join_tolerance: params.join_tolerance,
+            merge_tolerance: params.merge_tolerance,
+            junction_tolerance: params.junction_tolerance,
+        };
+        curves::CurveNetwork::build(&curve_mesh, &options)
+    })?;
     if net.points.len() > params.max_curve_vertices as usize {
         return Err(Error::TooLarge {
             what: "curve vertices (RBF centres)".into(),
@@ -360,6 +366,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "curve_polylines": net.polylines.len(),
         "feature_points": net.feature_count(),
         "curve_vertices_welded": net.welded_vertices,
+        "network": net.stats,
         "alignment": coarse,
         "fine": fine.report,
         "retriangulation": realised.stats,

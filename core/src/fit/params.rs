@@ -70,6 +70,14 @@ pub struct FitParams {
     pub coplanar_centres: CoplanarCentres,
     /// Curve endpoints closer than this × the curves' bounding-box diagonal are one vertex.
     pub join_tolerance: f64,
+    /// Consecutive curve points closer than this × the median curve segment length are merged
+    /// (a feature point keeps its position); the report's `network.near_duplicates_merged`
+    /// counts them (0 disables).
+    pub merge_tolerance: f64,
+    /// Curve ends within this × a segment's length of another polyline's segment are joined to
+    /// it (T-junction), and segments that cross with a gap below this × the shorter one's length
+    /// get a shared vertex (0 disables); counted in the report's `network`.
+    pub junction_tolerance: f64,
     /// A curve vertex farther than this × the template's bounding-box diagonal from every template
     /// vertex (after alignment) is an error.
     pub max_curve_distance: f64,
@@ -110,6 +118,8 @@ impl Default for FitParams {
             matching: Matching::Insert,
             coplanar_centres: CoplanarCentres::Reject,
             join_tolerance: 1e-6,
+            merge_tolerance: 1e-3,
+            junction_tolerance: 0.25,
             max_curve_distance: 0.25,
             end_snap: 0.05,
             max_flip_iterations: 4,
@@ -131,6 +141,12 @@ impl FitParams {
         let bad = |f: &str, m: &str| Err(Error::params(f, m));
         if !(self.join_tolerance.is_finite() && self.join_tolerance >= 0.0 && self.join_tolerance < 0.1) {
             return bad("join_tolerance", "must be in [0, 0.1)");
+        }
+        if !(self.merge_tolerance.is_finite() && (0.0..0.5).contains(&self.merge_tolerance)) {
+            return bad("merge_tolerance", "must be in [0, 0.5)");
+        }
+        if !(self.junction_tolerance.is_finite() && (0.0..=1.0).contains(&self.junction_tolerance)) {
+            return bad("junction_tolerance", "must be in [0, 1]");
         }
         if !(self.max_curve_distance.is_finite() && self.max_curve_distance > 0.0) {
             return bad("max_curve_distance", "must be > 0");

@@ -285,3 +285,141 @@ pub fn boundary_vertices(m: &Mesh) -> Vec<bool> {
     }
     on
 }
+
+// ---------------------------------------------------------------------------------------------
+// Analytic curve networks beyond plane sections (the networks sweep and `tests/fit_networks*.rs`).
+// Each curve is sampled from a closed-form curve on a closed-form surface; the truths (region
+// counts, distances) come from the geometry, not from the fit.
+
+/// A curves mesh from polylines given by their points. Every point gets its own index (nothing
+/// is shared), so joining shared endpoints is left to the fit, as with a real curve file.
+pub fn polylines(lines: &[Vec<Point3>]) -> Mesh {
+    let mut positions = Vec::new();
+    let mut curves = Vec::new();
+    for line in lines {
+        let start = positions.len() as u32;
+        positions.extend_from_slice(line);
+        curves.push((start..positions.len() as u32).collect());
+    }
+    Mesh { positions, curves, ..Default::default() }
+}
+
+/// The closed circle `c + r (cos t · u + sin t · v)` sampled at `n` points from angle `phase`,
+/// with the first point repeated at the end (so the polyline closes). `u`, `v` orthonormal.
+pub fn circle(c: Point3, u: Point3, v: Point3, r: f64, n: usize, phase: f64) -> Vec<Point3> {
+    let mut pts: Vec<Point3> = (0..n)
+        .map(|k| {
+            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
+            add(c, add(scale(u, r * t.cos()), scale(v, r * t.sin())))
+        })
+        .collect();
+    pts.push(pts[0]);
+    pts
+}
+
+/// The open arc of the same circle from angle `t0` to `t1`, `n` segments.
+pub fn arc(c: Point3, u: Point3, v: Point3, r: f64, t0: f64, t1: f64, n: usize) -> Vec<Point3> {
+    (0..=n)
+        .map(|k| {
+            let t = t0 + (t1 - t0) * k as f64 / n as f64;
+            add(c, add(scale(u, r * t.cos()), scale(v, r * t.sin())))
+        })
+        .collect()
+}
+
+/// A loxodrome (rhumb line) on the sphere of radius `r` about the origin: latitude from `-lat` to
+/// `lat`, longitude = `k` · atanh(sin latitude), `n` segments. It crosses the equator once, at
+/// longitude 0, at parameter `n / 2` (a vertex when `n` is even).
+pub fn loxodrome(r: f64, lat: f64, k: f64, n: usize) -> Vec<Point3> {
+    (0..=n)
+        .map(|i| {
+            let phi = -lat + 2.0 * lat * i as f64 / n as f64;
+            let lon = k * phi.sin().atanh();
+            [r * phi.cos() * lon.cos(), r * phi.cos() * lon.sin(), r * phi.sin()]
+        })
+        .collect()
+}
+
+/// The helix `(r cos t, r sin t, z0 + (z1 − z0) t / (2π turns))`, `n` segments.
+pub fn helix(r: f64, z0: f64, z1: f64, turns: f64, n: usize) -> Vec<Point3> {
+    (0..=n)
+        .map(|i| {
+            let s = i as f64 / n as f64;
+            let t = std::f64::consts::TAU * turns * s;
+            [r * t.cos(), r * t.sin(), z0 + (z1 - z0) * s]
+        })
+        .collect()
+}
+
+/// An open cylinder (no caps) of radius `r` about the z axis from z = 0 to z = `h`, `nu` vertices
+/// around and `nv` rings, triangulated, outward-oriented, two boundary loops.
+pub fn open_cylinder(nu: usize, nv: usize, r: f64, h: f64) -> Mesh {
+    let mut pos = Vec::with_capacity(nu * nv);
+    for j in 0..nv {
+        for i in 0..nu {
+            let t = std::f64::consts::TAU * i as f64 / nu as f64;
+            pos.push([r * t.cos(), r * t.sin(), h * j as f64 / (nv - 1) as f64]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * nu + i % nu) as u32;
+    let mut tris = Vec::new();
+    for j in 0..nv - 1 {
+        for i in 0..nu {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// The paraboloid z = a (x² + y²) over [−1, 1]², an `n × n` grid of cells with the cells whose
+/// centre has max(|x|, |y|) < `hole` removed (a square hole), triangulated, normals +z-ish.
+pub fn paraboloid_with_hole(n: usize, a: f64, hole: f64) -> Mesh {
+    let h = 2.0 / n as f64;
+    let mut pos = Vec::with_capacity((n + 1) * (n + 1));
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (-1.0 + i as f64 * h, -1.0 + j as f64 * h);
+            pos.push([x, y, a * (x * x + y * y)]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (cx, cy) = (-1.0 + (i as f64 + 0.5) * h, -1.0 + (j as f64 + 0.5) * h);
+            if cx.abs().max(cy.abs()) < hole {
+                continue;
+            }
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// Moves every point of `curves` by a pseudo-random offset of length ≤ `amplitude` (a fixed LCG
+/// from `seed`, so cases are reproducible). Points listed in `keep` stay put.
+pub fn jitter(curves: &mut Mesh, amplitude: f64, seed: u64, keep: &[u32]) {
+    let mut s = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut next = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    for (i, p) in curves.positions.iter_mut().enumerate() {
+        let d = [next(), next(), next()];
+        if keep.contains(&(i as u32)) {
+            continue;
+        }
+        *p = add(*p, scale(d, amplitude / 3f64.sqrt()));
+    }
+}
+
+/// The three great circles of the sphere of radius `r` about the origin in the coordinate planes
+/// (xy, xz, yz), each sampled independently with `n` points from its own phase. They cross
+/// pairwise at the six axis points ±r·e_k, which are polyline vertices only when the phase is a
+/// multiple of 2π/n (the phase 0 case shares them exactly); they cut the sphere into 8 octants.
+pub fn great_circles(r: f64, n: usize, phases: [f64; 3]) -> Vec<Vec<Point3>> {
+    let (o, x, y, z) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    vec![circle(o, x, y, r, n, phases[0]), circle(o, x, z, r, n, phases[1]), circle(o, y, z, r, n, phases[2])]
+}
