@@ -111,8 +111,8 @@ pub fn run(mesh: &Mesh, params: &ValidateParams, progress: &Progress) -> Result<
 /// The report without timings (what repair uses to describe its output).
 pub fn analyze(mesh: &Mesh) -> Report {
     let mut stages = Stages::new();
-    // A fresh Progress is never cancelled, so this cannot fail.
-    analyze_staged(mesh, 10, &mut stages, &Progress::new()).unwrap_or_else(|_| unreachable!())
+    analyze_staged(mesh, 10, &mut stages, &Progress::new())
+        .expect("analyze_staged fails only through progress.check(), and a fresh Progress is never cancelled")
 }
 
 /// The report, timing each stage into `stages`.

@@ -167,6 +167,39 @@ pub struct Prepared {
     pub reason: String,
 }
 
+/// `TooLarge` when input `k` has more than `max_vertices` vertices. Checked before repair and
+/// again after it (hole filling adds vertices).
+pub(super) fn check_vertex_limit(k: usize, m: &Mesh, max_vertices: usize) -> Result<()> {
+    if m.positions.len() > max_vertices {
+        return Err(Error::TooLarge {
+            what: format!("{} vertices", input_name(k)),
+            limit: max_vertices as u64,
+            actual: m.positions.len() as u64,
+        });
+    }
+    Ok(())
+}
+
+/// Input vertex → triangulated vertex: `tri_map` (from `TriMesh::from_mesh`) after the repair's
+/// vertex map when there was one, so feature indices still name the vertex the user meant.
+/// `u32::MAX` = the vertex is gone.
+pub(super) fn compose_vertex_maps(repair_map: Option<&[u32]>, tri_map: Vec<u32>) -> Vec<u32> {
+    match repair_map {
+        Some(rm) => {
+            rm.iter()
+                .map(|&r| {
+                    if r == u32::MAX {
+                        u32::MAX
+                    } else {
+                        tri_map.get(r as usize).copied().unwrap_or(u32::MAX)
+                    }
+                })
+                .collect()
+        }
+        None => tri_map,
+    }
+}
+
 /// Chooses the domain and, with `repair`, prepares every input for it (stage `repair`).
 pub fn prepare(
     inputs: Vec<Mesh>,
@@ -175,13 +208,7 @@ pub fn prepare(
     stages: &mut Stages,
 ) -> Result<Prepared> {
     for (k, m) in inputs.iter().enumerate() {
-        if m.positions.len() > params.max_vertices {
-            return Err(Error::TooLarge {
-                what: format!("{} vertices", input_name(k)),
-                limit: params.max_vertices as u64,
-                actual: m.positions.len() as u64,
-            });
-        }
+        check_vertex_limit(k, m, params.max_vertices)?;
     }
     let k_in = inputs.len();
     if !params.repair {

@@ -177,8 +177,16 @@ impl MorphParams {
         if !(2..=10_000).contains(&self.frames) {
             return Err(Error::params("frames", format!("must be 2..=10000, got {}", self.frames)));
         }
-        if !(self.duration_seconds.is_finite() && self.duration_seconds > 0.0) {
-            return Err(Error::params("duration_seconds", "must be a positive number"));
+        // The GLB stores keyframe times as f32, which must increase strictly: 1e300 s became
+        // infinity (reported as a NaN vertex) and 1e-300 s made every time 0.
+        if !(MIN_DURATION..=MAX_DURATION).contains(&self.duration_seconds) {
+            return Err(Error::params(
+                "duration_seconds",
+                format!(
+                    "must be {MIN_DURATION} to {MAX_DURATION:e} seconds (keyframe times are f32), got {}",
+                    self.duration_seconds
+                ),
+            ));
         }
         if !(4..=100_000).contains(&self.working_vertices) {
             return Err(Error::params("working_vertices", "must be 4..=100000"));
@@ -215,6 +223,11 @@ impl MorphParams {
     }
 }
 
+/// Shortest and longest animation (seconds): with up to 10,000 frames, the keyframe times stay
+/// distinct and finite in f32.
+const MIN_DURATION: f64 = 1e-3;
+const MAX_DURATION: f64 = 1e7;
+
 fn input_name(k: usize) -> String {
     match k {
         0 => "input 0 (source)".into(),
@@ -245,13 +258,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
         let mut convs = Vec::new();
         let mut topo = Vec::new();
         for (k, m) in inputs.iter().enumerate() {
-            if m.positions.len() > params.max_vertices {
-                return Err(Error::TooLarge {
-                    what: format!("{} vertices", input_name(k)),
-                    limit: params.max_vertices as u64,
-                    actual: m.positions.len() as u64,
-                });
-            }
+            domain::check_vertex_limit(k, m, params.max_vertices)?;
             let (mut t, map, conv) = TriMesh::from_mesh(m);
             let info = trimesh::topology(&t);
             trimesh::require_sphere_like(&info, &input_name(k)).map_err(|e| match e {
@@ -268,21 +275,7 @@ pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Resu
             convs.push(json!({"conversion": conv, "orientation_flipped": flipped}));
             topo.push(info);
             meshes.push(t);
-            // Input vertex → triangulated vertex, through the repair's map when there was one.
-            let map = match &repair_maps[k] {
-                Some(rm) => rm
-                    .iter()
-                    .map(|&r| {
-                        if r == u32::MAX {
-                            u32::MAX
-                        } else {
-                            map.get(r as usize).copied().unwrap_or(u32::MAX)
-                        }
-                    })
-                    .collect(),
-                None => map,
-            };
-            maps.push(map);
+            maps.push(domain::compose_vertex_maps(repair_maps[k].as_deref(), map));
         }
         Ok((meshes, maps, convs, topo))
     })?;

@@ -51,13 +51,7 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
     let (meshes, maps, conv, topo) = stages.run(progress, "validate", || {
         let (mut ms, mut maps, mut convs, mut topo) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (k, m) in inputs.iter().enumerate() {
-            if m.positions.len() > params.max_vertices {
-                return Err(Error::TooLarge {
-                    what: format!("{} vertices", input_name(k)),
-                    limit: params.max_vertices as u64,
-                    actual: m.positions.len() as u64,
-                });
-            }
+            super::domain::check_vertex_limit(k, m, params.max_vertices)?;
             let (t, map, c) = TriMesh::from_mesh(m);
             let info = trimesh::topology(&t);
             if !planar::is_disk(&info) {
@@ -79,20 +73,7 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
                 )));
             }
             ms.push(t);
-            // Input vertex → triangulated vertex, through the repair's map when there was one.
-            maps.push(match &repair_maps[k] {
-                Some(rm) => rm
-                    .iter()
-                    .map(|&r| {
-                        if r == u32::MAX {
-                            u32::MAX
-                        } else {
-                            map.get(r as usize).copied().unwrap_or(u32::MAX)
-                        }
-                    })
-                    .collect(),
-                None => map,
-            });
+            maps.push(super::domain::compose_vertex_maps(repair_maps[k].as_deref(), map));
             convs.push(c);
             topo.push(info);
         }

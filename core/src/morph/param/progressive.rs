@@ -108,9 +108,7 @@ fn embed_working_mesh(
         Ok((embedded, rounds)) => {
             rep.method = "curvature_flattening".into();
             rep.flatten_rounds = rounds;
-            for (k, &v) in map.iter().enumerate() {
-                sphere[v as usize] = embedded[k];
-            }
+            scatter(&map, &embedded, sphere);
             return Ok(());
         }
         Err(reason) => reason,
@@ -127,9 +125,7 @@ fn embed_working_mesh(
         match crate::morph::sphere_fallback::parameterise(&coarse, &fs, progress) {
             Ok((emb, _)) => {
                 rep.method = "tutte_coarse".into();
-                for (k, &v) in map.iter().enumerate() {
-                    sphere[v as usize] = emb[k];
-                }
+                scatter(&map, &emb, sphere);
                 return Ok(());
             }
             Err(Error::Numerical { .. }) => {}
@@ -140,6 +136,13 @@ fn embed_working_mesh(
     h.simplify(4, false, progress)?;
     let (map, tris) = h.current();
     embed_tetrahedron(&map, &tris, sphere)
+}
+
+/// Writes the working mesh's positions `emb` (working vertex k = full vertex `map[k]`) into `sphere`.
+fn scatter(map: &[u32], emb: &[Point3], sphere: &mut [Point3]) {
+    for (&v, &p) in map.iter().zip(emb) {
+        sphere[v as usize] = p;
+    }
 }
 
 /// Undoes the recorded collapses one vertex split at a time, relaxing every time the vertex
