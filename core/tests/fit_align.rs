@@ -101,3 +101,37 @@ fn automatic_alignment_fit_finds_every_region() {
     assert_eq!(r["segments_as_edges"].as_f64(), Some(1.0));
     assert_eq!(r["regions"].as_u64(), Some(expected as u64), "regions vs the planes' count");
 }
+
+/// Woody is a flat open figure (z = 0): its section crossings, where a user would pick pairs, all
+/// lie on the one lengthwise section, so the pairs are on one line and the coarse RBF (even with
+/// the normal augmentation) leaves the direction across that line free. With
+/// `coplanar_centres = "augment"` the fit falls back to a similarity from the pairs completed by
+/// ICP against the curves; truth: the bent template surface.
+#[test]
+fn pairs_on_one_line_of_a_flat_template_fall_back_to_a_similarity() {
+    use meshwork_core::fit::testdata::crossing_pairs;
+    use meshwork_core::fit::CoplanarCentres;
+    use meshwork_core::spatial::Bvh;
+    let m = shared("woody");
+    let sections = thin_network(&plane_sections(&m, &planes(&m)), 2);
+    let template = subdivide_midpoint(&m, 1);
+    let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
+    // The premise, checked independently: the pairs' template vertices are (nearly) collinear.
+    let xs: Vec<f64> = pairs.iter().map(|q| template.positions[q.template_vertex as usize][0]).collect();
+    assert!(pairs.len() >= 2 && xs.iter().all(|x| (x - xs[0]).abs() < 0.02), "{xs:?}");
+    let mut truth = template.clone();
+    for p in &mut truth.positions {
+        *p = bend(*p, 1.0);
+    }
+    let params = FitParams { pairs, coplanar_centres: CoplanarCentres::Augment, ..Default::default() };
+    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let r = &out.report;
+    eprintln!("alignment {}", r["alignment"]);
+    assert_eq!(r["alignment"]["method"], "pairs_similarity");
+    // (Flips and regions depend on the stages after the alignment; this test is about where the
+    // alignment puts the template: before the fallback the fit failed, curves 0.33 × diag away.)
+    eprintln!("flipped {} segments {}", r["flipped_faces"], r["segments_as_edges"]);
+    let diag = Aabb::of(&truth.positions).unwrap().diagonal();
+    let dev = Bvh::new(&truth.positions, &truth.faces).max_distance(&out.meshes[0].positions) / diag;
+    assert!(dev < 0.05, "output within 5% of the diagonal of the bent template: {dev}");
+}

@@ -138,7 +138,73 @@ pub fn fit_similarity(from: &[Point3], to: &[Point3]) -> Similarity {
     Similarity { r, s: sc, t: sub(mt, scale(rm, sc)) }
 }
 
-/// PCA start + similarity ICP. Returns the map template → curve space and its final RMS distance.
+const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Similarity ICP from `start`: each curve point is matched to its nearest template vertex (under
+/// the current map). Not trimmed: the curves are meant to lie on the template, and trimming let
+/// wrong poses of flat or near-symmetric templates score better than the right one (measured on
+/// alligator and homer of the fit sweep) by discarding exactly the matches that tell them apart.
+/// `anchors` (template point, target) are added to every fit
+/// `anchor_copies` times each (user pairs keep their weight against thousands of matches).
+/// Returns the map and its score: the RMS distance of the matches.
+fn icp(
+    template: &[Point3],
+    tree: &KdTree,
+    curve: &[Point3],
+    start: Similarity,
+    iterations: u32,
+    anchors: &[(Point3, Point3)],
+    anchor_copies: usize,
+    progress: &Progress,
+) -> Result<(Similarity, f64)> {
+    let mut m = start;
+    let mut score = f64::INFINITY;
+    for it in 0..=iterations {
+        progress.check()?;
+        let mut matches: Vec<(f64, Point3, Point3)> = Vec::with_capacity(curve.len());
+        for &c in curve {
+            if let Some((i, _)) = tree.nearest(m.inverse_apply(c)) {
+                let p = template[i as usize];
+                matches.push((norm2(sub(m.apply(p), c)), p, c));
+            }
+        }
+        if matches.is_empty() {
+            break;
+        }
+        score = (matches.iter().map(|x| x.0).sum::<f64>() / matches.len() as f64).sqrt();
+        if it == iterations {
+            break;
+        }
+        let (mut from, mut to): (Vec<Point3>, Vec<Point3>) = matches.iter().map(|&(_, p, c)| (p, c)).unzip();
+        for &(p, c) in anchors {
+            for _ in 0..anchor_copies {
+                from.push(p);
+                to.push(c);
+            }
+        }
+        if from.len() < 3 {
+            break;
+        }
+        m = fit_similarity(&from, &to);
+    }
+    Ok((m, score))
+}
+
+/// A spread subset of at most `k` points (every n/k-th).
+fn subsample(p: &[Point3], k: usize) -> Vec<Point3> {
+    let step = p.len().div_ceil(k.max(1)).max(1);
+    p.iter().step_by(step).copied().collect()
+}
+
+/// PCA start + similarity ICP. Returns the map template → curve space and its score (RMS
+/// distance of the curve points to their nearest template vertices).
+///
+/// Candidates: every proper rotation taking the template's principal axes onto the curves'
+/// (6 axis orders × 4 sign choices = 24). The axis *order* matters as much as the signs: the
+/// curves sample the surface unevenly (sections along one axis only, a partial network), so
+/// their spreads need not rank like the template's, and templates with two similar spreads
+/// (a flat figure, a round body) swap axes under any small change. Each candidate gets a short
+/// ICP on a subset of the curve points; the best three are refined on all of them.
 pub fn pca_icp(
     template: &[Point3],
     curve: &[Point3],
@@ -153,48 +219,101 @@ pub fn pca_icp(
         ((sc[0] + sc[1] + sc[2]) / curve.len() as f64 / ((st[0] + st[1] + st[2]) / template.len() as f64))
             .sqrt();
     let s0 = if s0.is_finite() && s0 > 0.0 { s0 } else { 1.0 };
-    let mut best: Option<(Similarity, f64)> = None;
-    for signs in [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]] {
-        // R = Ac · diag(signs) · Atᵀ (both proper when the PCA frames are; fix handedness).
-        let mut r = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                r[i][j] = (0..3).map(|k| ac[i][k] * signs[k] * at[j][k]).sum();
-            }
-        }
-        let det = dot(r[0], crate::geometry::cross(r[1], r[2]));
-        if det < 0.0 {
-            for row in r.iter_mut() {
-                for v in row.iter_mut() {
-                    *v = -*v;
+    let few = subsample(curve, 300);
+    let mut scored: Vec<(f64, Similarity)> = Vec::new();
+    for perm in [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]] {
+        for signs in [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]] {
+            // R = Ac · P · Atᵀ, P taking template axis k to curve axis perm[k] with a sign;
+            // flipped to a proper rotation if needed (the 24 results are distinct).
+            let mut r = [[0.0; 3]; 3];
+            for (i, row) in r.iter_mut().enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = (0..3).map(|k| ac[i][perm[k]] * signs[k] * at[j][k]).sum();
                 }
             }
-        }
-        let rm = [dot(r[0], mt), dot(r[1], mt), dot(r[2], mt)];
-        let mut m = Similarity { r, s: s0, t: sub(mc, scale(rm, s0)) };
-        let mut rms = f64::INFINITY;
-        for _ in 0..iterations {
-            progress.check()?;
-            let mut from = Vec::with_capacity(curve.len());
-            let mut err = 0.0;
-            for &c in curve {
-                if let Some((i, _)) = tree.nearest(m.inverse_apply(c)) {
-                    let p = template[i as usize];
-                    err += norm2(sub(m.apply(p), c));
-                    from.push(p);
+            if dot(r[0], crate::geometry::cross(r[1], r[2])) < 0.0 {
+                for row in r.iter_mut() {
+                    for v in row.iter_mut() {
+                        *v = -*v;
+                    }
                 }
             }
-            rms = (err / curve.len().max(1) as f64).sqrt();
-            m = fit_similarity(&from, curve);
-        }
-        if best.as_ref().is_none_or(|b| rms < b.1) {
-            best = Some((m, rms));
+            let rm = [dot(r[0], mt), dot(r[1], mt), dot(r[2], mt)];
+            let start = Similarity { r, s: s0, t: sub(mc, scale(rm, s0)) };
+            let (m, score) = icp(template, &tree, &few, start, iterations.min(10), &[], 0, progress)?;
+            scored.push((score, m));
         }
     }
-    Ok(best.unwrap_or((
-        Similarity { r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], s: 1.0, t: [0.0; 3] },
-        f64::INFINITY,
-    )))
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut best: Option<(Similarity, f64)> = None;
+    for (_, start) in scored.into_iter().take(3) {
+        let (m, score) = icp(template, &tree, curve, start, iterations, &[], 0, progress)?;
+        if best.as_ref().is_none_or(|b| score < b.1) {
+            best = Some((m, score));
+        }
+    }
+    Ok(best.unwrap_or((Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] }, f64::INFINITY)))
+}
+
+/// Similarity ICP started from the user's pairs, for pairs too degenerate for the coarse RBF
+/// (all on one line, or on one plane of a flat template). The pairs' similarity (Horn) is the
+/// start; when the pairs are (nearly) on one line, the rotation about that line is free, so 8
+/// starts turned about it are tried. The pairs stay in every ICP fit with a weight of a quarter
+/// of the curve points, so the curves decide only what the pairs leave open.
+pub fn pairs_icp(
+    template: &[Point3],
+    curve: &[Point3],
+    pairs: &[(Point3, Point3)],
+    iterations: u32,
+    progress: &Progress,
+) -> Result<(Similarity, f64)> {
+    let tree = KdTree::new(template);
+    let (from, to): (Vec<Point3>, Vec<Point3>) = pairs.iter().copied().unzip();
+    let horn = fit_similarity(&from, &to);
+    let mut starts = vec![horn];
+    let [_, thin] = super::rbf::spread_ratios(&to);
+    if pairs.len() < 3 || thin < 0.05 {
+        let (axes, _) = pca(&to);
+        let axis = [axes[0][0], axes[1][0], axes[2][0]];
+        let centre = mean(&to);
+        for k in 1..8 {
+            let rot = axis_rotation(axis, k as f64 * std::f64::consts::FRAC_PI_4);
+            // x ↦ centre + rot·(horn(x) − centre)
+            let mut r = [[0.0; 3]; 3];
+            for (i, row) in r.iter_mut().enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = (0..3).map(|l| rot[i][l] * horn.r[l][j]).sum();
+                }
+            }
+            let rt = [
+                dot(rot[0], sub(horn.t, centre)),
+                dot(rot[1], sub(horn.t, centre)),
+                dot(rot[2], sub(horn.t, centre)),
+            ];
+            starts.push(Similarity { r, s: horn.s, t: add(centre, rt) });
+        }
+    }
+    let copies = (curve.len() / 4 / pairs.len().max(1)).max(1);
+    let mut best: Option<(Similarity, f64)> = None;
+    for start in starts {
+        let (m, score) = icp(template, &tree, curve, start, iterations, pairs, copies, progress)?;
+        if best.as_ref().is_none_or(|b| score < b.1) {
+            best = Some((m, score));
+        }
+    }
+    Ok(best.unwrap_or((horn, f64::INFINITY)))
+}
+
+/// Rotation by `angle` about the unit `axis` (Rodrigues).
+fn axis_rotation(axis: Point3, angle: f64) -> [[f64; 3]; 3] {
+    let (s, c) = angle.sin_cos();
+    let [x, y, z] = axis;
+    let t = 1.0 - c;
+    [
+        [c + x * x * t, x * y * t - z * s, x * z * t + y * s],
+        [y * x * t + z * s, c + y * y * t, y * z * t - x * s],
+        [z * x * t - y * s, z * y * t + x * s, c + z * z * t],
+    ]
 }
 
 /// What the smooth warp of [`warp_icp`] did (serialised into the report).

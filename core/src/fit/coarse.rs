@@ -13,7 +13,9 @@ use super::{align, curves, kdtree, rbf, Alignment, CoplanarCentres, FitPair, Fit
 /// What the coarse stage did (serialised into the report).
 #[derive(Debug, Clone, Serialize)]
 pub struct CoarseReport {
-    /// "pairs", "pca_icp" or "none".
+    /// "pairs" (coarse RBF through the pairs), "pairs_similarity" (pairs on one line, with
+    /// `coplanar_centres = "augment"`: similarity from the pairs + ICP + warp), "pca_icp"
+    /// (no pairs: PCA + ICP + warp) or "none".
     pub method: &'static str,
     /// Curve vertex each pair snapped to, per pair.
     pub pair_curve_points: Vec<u32>,
@@ -41,6 +43,9 @@ pub(super) fn coarse_alignment(
     };
     if use_pairs {
         let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net)?;
+        if params.coplanar_centres == CoplanarCentres::Augment && pairs_on_a_line(pos, &fixed, net) {
+            return pairs_similarity(pos, tris, net, &fixed, snap_max, progress);
+        }
         let centres: Vec<Point3> = fixed.iter().map(|&(_, v)| pos[v as usize]).collect();
         let values: Vec<Point3> =
             fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
@@ -89,6 +94,47 @@ pub(super) fn coarse_alignment(
         method: "pca_icp",
         pair_curve_points: vec![],
         pair_snap_distance_max: 0.0,
+        icp_rms: Some(rms),
+        warp: Some(warp),
+    })
+}
+
+/// Pairs too few or too close to one line (on either side) for the coarse RBF, even with the
+/// normal augmentation: on a flat template the normals add the one direction the plane lacks,
+/// but pairs along one line of it leave the direction across the line free, and the RBF's
+/// affine part extrapolates without bound there (measured: woody's 4 pairs, all on one section,
+/// put the curves 0.33 × the diagonal off the template).
+fn pairs_on_a_line(pos: &[Point3], fixed: &[(u32, u32)], net: &curves::CurveNetwork) -> bool {
+    let centres: Vec<Point3> = fixed.iter().map(|&(_, v)| pos[v as usize]).collect();
+    let targets: Vec<Point3> = fixed.iter().map(|&(p, _)| net.points[p as usize]).collect();
+    fixed.len() >= 2
+        && (fixed.len() < 4
+            || rbf::spread_ratios(&centres)[1] < 0.05
+            || rbf::spread_ratios(&targets)[1] < 0.05)
+}
+
+/// The fallback for [`pairs_on_a_line`]: a similarity from the pairs, completed by ICP against
+/// the curves (the pairs weighted in), then the smooth warp. The fine stage still lands every
+/// pair's template vertex exactly on its curve vertex.
+fn pairs_similarity(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    fixed: &[(u32, u32)],
+    snap_max: f64,
+    progress: &Progress,
+) -> Result<CoarseReport> {
+    let pairs: Vec<(Point3, Point3)> =
+        fixed.iter().map(|&(p, v)| (pos[v as usize], net.points[p as usize])).collect();
+    let (sim, rms) = align::pairs_icp(pos, &net.points, &pairs, 30, progress)?;
+    for p in pos.iter_mut() {
+        *p = sim.apply(*p);
+    }
+    let warp = align::warp_icp(pos, tris, &net.points, WARP_ITERATIONS, progress)?;
+    Ok(CoarseReport {
+        method: "pairs_similarity",
+        pair_curve_points: fixed.iter().map(|x| x.0).collect(),
+        pair_snap_distance_max: snap_max,
         icp_rms: Some(rms),
         warp: Some(warp),
     })
