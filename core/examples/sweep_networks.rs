@@ -12,7 +12,8 @@
 //!
 //! Run from the repository root:
 //! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example sweep_networks [NAME…]`
-//! (`SWEEP_FAILED=1` also prints the segments that could not be made edge chains.)
+//! (`SWEEP_FAILED=1` also prints the segments that could not be made edge chains; `SWEEP_OUT=DIR`
+//! writes each output and its curves as OBJ to DIR and prints the faces per region.)
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::time::Instant;
@@ -247,6 +248,25 @@ fn main() {
                 let r = &out.report;
                 if std::env::var("SWEEP_FAILED").is_ok() {
                     eprintln!("{}: {}", c.name, r["retriangulation"]["failed"]);
+                }
+                if let Ok(dir) = std::env::var("SWEEP_OUT") {
+                    // The output (one group per region) and the curves, to look at.
+                    let obj = meshwork_core::io::write(&out.meshes[0], meshwork_core::io::Format::Obj);
+                    let _ = std::fs::write(format!("{dir}/{}.obj", c.name), obj.unwrap_or_default());
+                    let curves = meshwork_core::io::write(&c.curves, meshwork_core::io::Format::Obj);
+                    let _ =
+                        std::fs::write(format!("{dir}/{}-curves.obj", c.name), curves.unwrap_or_default());
+                    let sizes: Vec<usize> = (0..out.meshes[0].groups.len())
+                        .map(|g| {
+                            (0..out.meshes[0].faces.len())
+                                .filter(|&f| out.meshes[0].faces.group(f) as usize == g)
+                                .count()
+                        })
+                        .collect();
+                    eprintln!(
+                        "{}: faces per region {sizes:?}, alignment {}",
+                        c.name, r["alignment"]["method"]
+                    );
                 }
                 let dev = out.meshes[0].positions.iter().map(|&p| (c.surface)(p)).fold(0.0, f64::max) / diag;
                 let net = &r["network"];

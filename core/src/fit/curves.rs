@@ -97,9 +97,11 @@ pub struct NetworkStats {
 }
 
 impl CurveNetwork {
-    /// [`CurveNetwork::build`] with the default merge and junction tolerances.
+    /// The raw network: welded, zero-length segments and one-point polylines removed, but no
+    /// near-duplicate merge and no junctions (tests of later stages feed crossing inputs on
+    /// purpose). The fit job uses [`CurveNetwork::build`] with its parameters.
     pub fn from_mesh(curves: &Mesh, join_tolerance: f64) -> Result<Self> {
-        Self::build(curves, &NetworkOptions { join_tolerance, ..Default::default() })
+        Self::build(curves, &NetworkOptions { join_tolerance, merge_tolerance: 0.0, junction_tolerance: 0.0 })
     }
 
     /// Builds the network from the polylines of `curves` (`Mesh::curves`). Faces of the curves
