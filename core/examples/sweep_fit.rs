@@ -137,12 +137,18 @@ fn main() {
                     if std::env::var("SWEEP_FAILED").is_ok() {
                         eprintln!("{name} {label}: {}", r["retriangulation"]["failed"]);
                     }
+                    if std::env::var("SWEEP_UNTANGLE").is_ok() {
+                        eprintln!(
+                            "{name} {label}: untangle {} cleanup {}",
+                            r["untangle"], r["cleanup"]["bad_faces_after"]
+                        );
+                    }
                     println!(
                         "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>8.2} {:>4}/{:<4} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
                         template.positions.len(),
                         curves.positions.len(),
                         secs,
-                        r["flipped_faces"],
+                        format!("{}/{}", r["flipped_faces_before_smoothing"], r["flipped_faces"]),
                         100.0 * r["segments_as_edges"].as_f64().unwrap_or(f64::NAN),
                         r["regions"],
                         expected,

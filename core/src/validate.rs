@@ -260,42 +260,28 @@ pub fn distinct_count(f: &[u32]) -> usize {
 /// Indices of faces whose vertex set equals that of an earlier face (winding and start ignored).
 pub fn duplicate_faces(faces: &crate::mesh::Faces) -> Vec<usize> {
     // Key: the sorted vertex list. Triangles (the common case) are sorted as fixed arrays.
-    let mut dup = Vec::new();
-    if let Some(tris) = faces.as_triangles() {
-        let mut keys: Vec<([u32; 3], u32)> = tris
-            .chunks_exact(3)
-            .enumerate()
-            .map(|(i, t)| {
-                let mut k = [t[0], t[1], t[2]];
-                k.sort_unstable();
-                (k, i as u32)
-            })
-            .collect();
-        keys.sort_unstable();
-        for w in keys.windows(2) {
-            if w[0].0 == w[1].0 {
-                dup.push(w[1].1 as usize);
-            }
-        }
-    } else {
-        let mut keys: Vec<(Vec<u32>, u32)> = faces
-            .iter()
-            .enumerate()
-            .map(|(i, f)| {
-                let mut k = f.to_vec();
-                k.sort_unstable();
-                (k, i as u32)
-            })
-            .collect();
-        keys.sort_unstable();
-        for w in keys.windows(2) {
-            if w[0].0 == w[1].0 {
-                dup.push(w[1].1 as usize);
-            }
-        }
-    }
+    let mut dup = match faces.as_triangles() {
+        Some(tris) => later_repeats(tris.chunks_exact(3).map(|t| {
+            let mut k = [t[0], t[1], t[2]];
+            k.sort_unstable();
+            k
+        })),
+        None => later_repeats(faces.iter().map(|f| {
+            let mut k = f.to_vec();
+            k.sort_unstable();
+            k
+        })),
+    };
     dup.sort_unstable();
     dup
+}
+
+/// Positions (in `keys`' order) of the keys equal to some other key: all but one of each run of
+/// equal keys, in no particular order.
+fn later_repeats<K: Ord>(keys: impl Iterator<Item = K>) -> Vec<usize> {
+    let mut keys: Vec<(K, u32)> = keys.enumerate().map(|(i, k)| (k, i as u32)).collect();
+    keys.sort_unstable();
+    keys.windows(2).filter(|w| w[0].0 == w[1].0).map(|w| w[1].1 as usize).collect()
 }
 
 #[cfg(test)]

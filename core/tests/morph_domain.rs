@@ -5,7 +5,6 @@
 //! brute-force closest points, the hand-counted hole and rim.
 
 use std::f64::consts::{PI, TAU};
-use std::path::{Path, PathBuf};
 
 use meshwork_core::error::Error;
 use meshwork_core::geometry::{norm, sub, triangle_area, Aabb};
@@ -16,21 +15,14 @@ use meshwork_core::shapes;
 use meshwork_core::spatial::closest_on_triangle;
 use serde_json::json;
 
+mod morph_support;
+use morph_support::load;
+
 const RINGS: usize = 10;
 const SEG: usize = 24;
 /// Centre of the punched hole (on the unit sphere, 45° from the pole) and its radius.
 const HOLE_AT: Point3 = [0.70710678118654757, 0.0, 0.70710678118654757];
 const HOLE_R: f64 = 0.25;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
-}
-
-fn load(name: &str) -> Mesh {
-    let p = root().join("../shared/meshes").join(name);
-    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
-}
 
 fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     shapes::fan_triangles(&m.faces)

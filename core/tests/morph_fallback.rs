@@ -4,7 +4,6 @@
 //! up to 4π covers the sphere exactly once), brute-force closest points for the end frames.
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
 
 use meshwork_core::geometry::{cross, dot, norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
@@ -14,24 +13,9 @@ use meshwork_core::morph::sphere_fallback::{self, FallbackSettings};
 use meshwork_core::morph::trimesh::TriMesh;
 use meshwork_core::register;
 use meshwork_core::shapes;
-use meshwork_core::spatial::closest_on_triangle;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
-}
-
-fn load(name: &str) -> Mesh {
-    let p = root().join("../shared/meshes").join(name);
-    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
-}
-
-/// Signed area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee).
-fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
-    let num = dot(a, cross(b, c));
-    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
-    2.0 * num.atan2(den)
-}
+mod morph_support;
+use morph_support::{bbox_diag, load, max_dist_brute, spherical_area};
 
 /// Every spherical triangle positive and the areas adding up to 4π: a bijection onto the sphere.
 fn assert_covers_sphere_once(name: &str, sphere: &[Point3], tris: &[[u32; 3]]) {
@@ -173,26 +157,6 @@ fn a_failing_progressive_path_falls_back_and_says_why() {
     let normal = param::parameterise(&t, &ParamSettings::default(), &Progress::new()).expect("progressive");
     assert_eq!(normal.report.param_method, "progressive");
     assert!(normal.report.param_fallback_reason.is_none());
-}
-
-/// Max over `pts` of the distance to the nearest triangle of (pos, tris), by brute force.
-fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
-    pts.iter()
-        .map(|&p| {
-            tris.iter()
-                .map(|t| {
-                    norm(sub(
-                        p,
-                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
-                    ))
-                })
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
-}
-
-fn bbox_diag(p: &[Point3]) -> f64 {
-    meshwork_core::geometry::Aabb::of(p).expect("non-empty").diagonal()
 }
 
 #[test]

@@ -2,54 +2,17 @@
 //! spherical triangle areas (a fold-free map covers the sphere exactly once), brute-force closest
 //! points for the end frames, an analytic ellipsoid, the Khronos validator for the GLB.
 
-use std::path::{Path, PathBuf};
-
 use meshwork_core::error::Error;
-use meshwork_core::geometry::{cross, dot, norm, sub};
+use meshwork_core::geometry::{dot, norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings};
 use meshwork_core::morph::trimesh::TriMesh;
 use meshwork_core::register;
 use meshwork_core::shapes;
-use meshwork_core::spatial::closest_on_triangle;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
-}
-
-fn load(name: &str) -> Mesh {
-    let p = root().join("../shared/meshes").join(name);
-    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
-}
-
-/// Area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee), signed.
-fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
-    let num = dot(a, cross(b, c));
-    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
-    2.0 * num.atan2(den)
-}
-
-/// Max over `pts` of the distance to the nearest triangle of (pos, tris), by brute force.
-fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
-    pts.iter()
-        .map(|&p| {
-            tris.iter()
-                .map(|t| {
-                    norm(sub(
-                        p,
-                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
-                    ))
-                })
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
-}
-
-fn bbox_diag(p: &[Point3]) -> f64 {
-    meshwork_core::geometry::Aabb::of(p).expect("non-empty").diagonal()
-}
+mod morph_support;
+use morph_support::{bbox_diag, load, max_dist_brute, root, spherical_area};
 
 fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
     let mut m = shapes::icosphere(levels, 1.0);

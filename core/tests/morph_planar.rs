@@ -3,8 +3,6 @@
 //! closest points for the end frames, plane triangle areas of the map (a fold-free map of the
 //! disk covers the boundary polygon exactly once), Python's `zipfile`, the Khronos validator.
 
-use std::path::{Path, PathBuf};
-
 use meshwork_core::error::Error;
 use meshwork_core::geometry::{dot, norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
@@ -12,39 +10,12 @@ use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::planar::{self, PlanarMethod};
 use meshwork_core::morph::trimesh::TriMesh;
 use meshwork_core::shapes;
-use meshwork_core::spatial::closest_on_triangle;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
-}
-
-fn load(name: &str) -> Mesh {
-    let p = root().join("../shared/meshes").join(name);
-    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
-}
-
-fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
-    pts.iter()
-        .map(|&p| {
-            tris.iter()
-                .map(|t| {
-                    norm(sub(
-                        p,
-                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
-                    ))
-                })
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
-}
+mod morph_support;
+use morph_support::{bbox_diag, load, max_dist_brute, root};
 
 fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     shapes::fan_triangles(&m.faces)
-}
-
-fn bbox_diag(p: &[Point3]) -> f64 {
-    meshwork_core::geometry::Aabb::of(p).expect("non-empty").diagonal()
 }
 
 /// Symmetric vertex-sampled Hausdorff distance between two meshes, relative to b's diagonal

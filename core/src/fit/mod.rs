@@ -157,6 +157,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
+    let fine_parents = parents.len();
     parents.extend_from_slice(&realised.added);
     // Vertices split into crossed edges take the reference normal of their edge.
     for a in &realised.added {
@@ -241,6 +242,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
     };
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
+    let flipped_before_smoothing = untangle::count_flipped(&mesh.pos, &out_tris, &reference_normals);
     let mut out_pos = mesh.pos.clone();
     let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
@@ -255,6 +257,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
         })?;
     }
+    // Smoothed vertices slid over the surface: their UVs are read where they now are.
+    let smooth_uv_moves =
+        if params.smooth && template.uvs.is_some() { uvs::relocate(&mesh, &out_pos) } else { Vec::new() };
+    let smooth_moved: Vec<u32> =
+        (0..out_pos.len() as u32).filter(|&v| out_pos[v as usize] != mesh.pos[v as usize]).collect();
     // Smoothing moves free vertices by tangential steps that can fold a face in a tight spot: the
     // same untangling, against the same reference, on the smoothed positions.
     let untangle_smoothed = if params.smooth {
@@ -311,8 +318,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     }
     let mut out = Mesh::new(out_pos, faces);
     out.uvs = template.uvs.as_ref().map(|uv| {
-        let mut uvs = interpolate_uvs(uv, &parents);
+        // In the order the vertices were made and moved: fine-stage splits, fine untangling,
+        // re-triangulation splits and moves, its untangling, smoothing, the last untangling.
+        let mut uvs = interpolate_uvs(uv, &parents[..fine_parents]);
+        uvs::apply_batches(&mut uvs, &untangle_fine.uv_batches);
+        let mut uvs = interpolate_uvs(&uvs, &parents[fine_parents..]);
         uvs::apply(&mut uvs, &realised.uv_moves);
+        uvs::apply_batches(&mut uvs, &untangle_retri.uv_batches);
+        uvs::apply_batches(&mut uvs, std::slice::from_ref(&smooth_uv_moves));
+        if let Some(s) = &untangle_smoothed {
+            uvs::apply_batches(&mut uvs, &s.uv_batches);
+        }
         keep.vec(&uvs)
     });
     out.groups = group_names;
@@ -329,6 +345,15 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &reference_normals,
         ))
     })?;
+    // Every vertex moved over the surface (its UV re-read where it landed), in the numbering
+    // before the clean-up: re-triangulation snaps, untangling, smoothing.
+    let mut moved_vertices: Vec<u32> = realised.uv_moves.iter().map(|m| m.vertex).collect();
+    for s in [Some(&untangle_fine), Some(&untangle_retri), untangle_smoothed.as_ref()].into_iter().flatten() {
+        moved_vertices.extend(s.uv_batches.iter().flatten().map(|m| m.vertex));
+    }
+    moved_vertices.extend_from_slice(&smooth_moved);
+    moved_vertices.sort_unstable();
+    moved_vertices.dedup();
     let report = serde_json::json!({
         "template_vertices": template.vertex_count(),
         "template_faces": template.face_count(),
@@ -354,8 +379,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "segments_as_edges": quality.segments_as_edges,
         "flipped_faces": quality.flipped_faces,
         "flipped_faces_after_fine": fine.report.flipped_faces,
+        "flipped_faces_before_smoothing": flipped_before_smoothing,
         "cleanup": cleaned,
-        "moved_vertices": realised.uv_moves.iter().map(|m| m.vertex).collect::<Vec<_>>(),
+        "moved_vertices": moved_vertices,
         "smoothing": smoothing,
         "min_angle_deg_after_retriangulation": angles_retri.min_deg,
         "mean_min_angle_deg_after_retriangulation": angles_retri.mean_min_deg,

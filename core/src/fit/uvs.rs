@@ -1,5 +1,6 @@
 //! Texture coordinates of vertices the fit *moves* over the surface (vertices snapped onto a
-//! curve segment by the re-triangulation, or pulled onto it by the Dijkstra fallback).
+//! curve segment by the re-triangulation, or pulled onto it by the Dijkstra fallback; vertices
+//! moved by the untangling and by the smoothing).
 //!
 //! A moved vertex keeps its index but now sits somewhere else on the surface, so its old UV is
 //! wrong there. Its new UV is interpolated, barycentrically, in the face that contains its new
@@ -79,4 +80,33 @@ pub fn apply(uvs: &mut [[f64; 2]], moves: &[UvMove]) {
         }
         uvs[m.vertex as usize] = u;
     }
+}
+
+/// Applies batches in order; the moves of one batch are simultaneous (each one's weights refer to
+/// the UVs before the batch, as its positions were located on the mesh before the batch moved).
+pub fn apply_batches(uvs: &mut [[f64; 2]], batches: &[Vec<UvMove>]) {
+    for b in batches {
+        let new: Vec<[f64; 2]> = b
+            .iter()
+            .map(|m| {
+                m.weights.iter().fold([0.0; 2], |u, &(v, w)| {
+                    [u[0] + w * uvs[v as usize][0], u[1] + w * uvs[v as usize][1]]
+                })
+            })
+            .collect();
+        for (m, u) in b.iter().zip(new) {
+            uvs[m.vertex as usize] = u;
+        }
+    }
+}
+
+/// One batch for every vertex whose position differs between `mesh.pos` (before) and `after`
+/// (e.g. smoothing): each new position located on `mesh` as it is.
+pub fn relocate(mesh: &TriMesh, after: &[Point3]) -> Vec<UvMove> {
+    use rayon::prelude::*;
+    (0..mesh.pos.len().min(after.len()) as u32)
+        .into_par_iter()
+        .filter(|&v| mesh.pos[v as usize] != after[v as usize] && !mesh.faces_of(v).is_empty())
+        .filter_map(|v| record(mesh, v, after[v as usize]))
+        .collect()
 }

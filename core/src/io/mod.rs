@@ -120,14 +120,8 @@ pub fn read(bytes: &[u8], opts: &ReadOptions) -> Result<Loaded> {
 
 /// The name used in [`Error::Malformed`] for a format.
 pub(crate) fn format_name(f: Format) -> &'static str {
-    match f {
-        Format::Obj => "obj",
-        Format::Gltf => "gltf",
-        Format::Glb => "glb",
-        Format::Ply => "ply",
-        Format::Stl => "stl",
-        Format::Off => "off",
-    }
+    // The name is the file extension.
+    f.extension()
 }
 
 /// The format of `bytes`, from magic numbers and content; `name_hint` only decides when the

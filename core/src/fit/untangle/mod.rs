@@ -21,11 +21,14 @@ use crate::geometry::{add, dot, scale, sub, triangle_cross};
 use crate::mesh::Point3;
 
 use super::trimesh::{IntHasher, TriMesh};
+use super::uvs::{self, UvMove};
+
+mod patch;
 
 /// A face counts as folded when its normal is within this cosine of perpendicular to the reference
 /// (or beyond): a face standing on its edge, e.g. three consecutive vertices of one planar curve,
 /// is as wrong as a flipped one and one round-off away from it.
-const MIN_COS: f64 = 0.05;
+pub(crate) const MIN_COS: f64 = 0.05;
 
 pub type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
 
@@ -34,10 +37,17 @@ pub struct UntangleStats {
     pub folded_before: usize,
     pub edge_flips: usize,
     pub vertex_moves: usize,
+    /// Folded regions untangled by moving all their free vertices at once ([`patch`]).
+    pub patches_solved: usize,
+    pub patch_vertex_moves: usize,
     pub folded_after: usize,
+    /// Where the moved vertices went, as batches of simultaneous moves located on the mesh before
+    /// each batch (in order): their UVs follow ([`uvs::apply_batches`]).
+    #[serde(skip)]
+    pub uv_batches: Vec<Vec<UvMove>>,
 }
 
-struct Ctx<'a> {
+pub(crate) struct Ctx<'a> {
     reference: &'a [Point3],
     fixed: &'a [bool],
     locked: &'a EdgeSet,
@@ -67,6 +77,18 @@ impl Ctx<'_> {
     }
 }
 
+/// Faces of `tris` turned against their reference: the normal at `pos` opposes the sum of the
+/// corners' `reference` normals. The same test as the report's `flipped_faces`
+/// ([`super::report::Quality::measure`]), for counting at other points of the pipeline.
+pub fn count_flipped(pos: &[Point3], tris: &[[u32; 3]], reference: &[Point3]) -> usize {
+    tris.iter()
+        .filter(|t| {
+            let r = t.iter().fold([0.0; 3], |acc, &v| add(acc, reference[v as usize]));
+            dot(triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]), r) < 0.0
+        })
+        .count()
+}
+
 /// Untangles `mesh` in place. `reference`: a unit normal per vertex (zero for none); `fixed`:
 /// vertices that must not move (len ≥ mesh vertices); `locked`: undirected edges that must stay.
 pub fn untangle(
@@ -78,8 +100,32 @@ pub fn untangle(
 ) -> UntangleStats {
     let ctx = Ctx { reference, fixed, locked };
     let mut stats = UntangleStats::default();
+    let count =
+        |mesh: &TriMesh| mesh.alive_faces().filter(|&f| ctx.folded(mesh, mesh.tris[f as usize])).count();
+    stats.folded_before = count(mesh);
+    let mut left = local_passes(mesh, &ctx, &mut stats, max_passes);
+    // What one-vertex moves and flips leave: whole regions at once, then the local fixes again
+    // (a region's new layout can open a flip that was blocked).
+    for _ in 0..3 {
+        if left == 0 {
+            break;
+        }
+        let pass = patch::untangle_patches(mesh, &ctx);
+        if pass.patches_solved == 0 {
+            break;
+        }
+        stats.patches_solved += pass.patches_solved;
+        stats.patch_vertex_moves += pass.vertices_moved;
+        stats.uv_batches.extend(pass.uv_batches);
+        left = local_passes(mesh, &ctx, &mut stats, max_passes);
+    }
+    stats.folded_after = left;
+    stats
+}
+
+/// Edge flips and ring-mean moves, face by face, until nothing changes; returns the folded count.
+fn local_passes(mesh: &mut TriMesh, ctx: &Ctx, stats: &mut UntangleStats, max_passes: usize) -> usize {
     let mut bad: Vec<u32> = mesh.alive_faces().filter(|&f| ctx.folded(mesh, mesh.tris[f as usize])).collect();
-    stats.folded_before = bad.len();
     for _ in 0..max_passes {
         if bad.is_empty() {
             break;
@@ -89,11 +135,12 @@ pub fn untangle(
             if !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
                 continue;
             }
-            if try_edge_flip(mesh, &ctx, f) {
+            if try_edge_flip(mesh, ctx, f) {
                 stats.edge_flips += 1;
                 progress = true;
-            } else if try_moves(mesh, &ctx, f) {
+            } else if let Some(m) = try_moves(mesh, ctx, f) {
                 stats.vertex_moves += 1;
+                stats.uv_batches.push(m.into_iter().collect());
                 progress = true;
             }
         }
@@ -102,8 +149,7 @@ pub fn untangle(
             break;
         }
     }
-    stats.folded_after = bad.len();
-    stats
+    bad.len()
 }
 
 /// Flips the best non-locked edge of folded face `f` when both new faces are unfolded.
@@ -142,8 +188,9 @@ fn try_edge_flip(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
 }
 
 /// Moves one free vertex of `f` (or of a face around `f`'s corners) to a ring mean when that
-/// unfolds every face around it and reduces the folded count.
-fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
+/// unfolds every face around it and reduces the folded count. Returns whether a vertex moved, with
+/// its UV move when its new position could be located.
+fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> Option<Option<UvMove>> {
     let t = mesh.tris[f as usize];
     let mut cand: Vec<u32> = t.iter().copied().filter(|&v| !ctx.fixed[v as usize]).collect();
     for &v in &t {
@@ -184,12 +231,13 @@ fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
                 ctx.score(tg, |w| if w == v { target } else { mesh.pos[w as usize] }) > MIN_COS
             });
             if ok {
+                let uv = uvs::record(mesh, v, target);
                 mesh.pos[v as usize] = target;
-                return true;
+                return Some(uv);
             }
         }
     }
-    false
+    None
 }
 
 #[cfg(test)]

@@ -1,0 +1,47 @@
+//! Helpers shared by the `morph_*` integration tests: loading the shared meshes and the
+//! brute-force measures the tests compare the morph's results against.
+// Each test crate uses a different subset.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use meshwork_core::geometry::{cross, dot, norm, sub};
+use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::spatial::closest_on_triangle;
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("core has a parent").to_path_buf()
+}
+
+pub fn load(name: &str) -> Mesh {
+    let p = root().join("../shared/meshes").join(name);
+    let bytes = std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    meshwork_core::io::read(&bytes, &Default::default()).expect("readable").mesh
+}
+
+pub fn bbox_diag(p: &[Point3]) -> f64 {
+    meshwork_core::geometry::Aabb::of(p).expect("non-empty").diagonal()
+}
+
+/// Max over `pts` of the distance to the nearest triangle of (pos, tris), by brute force.
+pub fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
+    pts.iter()
+        .map(|&p| {
+            tris.iter()
+                .map(|t| {
+                    norm(sub(
+                        p,
+                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
+                    ))
+                })
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee), signed.
+pub fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
+    let num = dot(a, cross(b, c));
+    let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
+    2.0 * num.atan2(den)
+}
