@@ -127,11 +127,39 @@ pub struct TopologyInfo {
     pub genus: Option<i64>,
 }
 
+/// Counts of the mesh's topology (edges, boundary loops, non-manifold parts, components, genus).
 pub fn topology(m: &TriMesh) -> TopologyInfo {
     let nv = m.pos.len();
+    let (edges, boundary_edges, non_manifold_edges) = classify_edges(&m.tris);
+    let boundary_loops = count_boundary_loops(&boundary_edges);
+    let non_manifold_vertices = count_non_manifold_vertices(m);
+    let components = count_components(nv, &m.tris);
+    let chi = nv as i64 - edges as i64 + m.tris.len() as i64;
+    let genus = (components == 1
+        && boundary_loops == 0
+        && non_manifold_edges == 0
+        && non_manifold_vertices == 0
+        && (2 - chi) % 2 == 0)
+        .then_some((2 - chi) / 2);
+    TopologyInfo {
+        vertices: nv,
+        edges,
+        faces: m.tris.len(),
+        components,
+        boundary_loops,
+        non_manifold_edges,
+        non_manifold_vertices,
+        euler_characteristic: chi,
+        genus,
+    }
+}
+
+/// The number of undirected edges, the boundary half-edges (used once, in the direction a face
+/// uses them) and the number of non-manifold edges (any other use count).
+fn classify_edges(tris: &[[u32; 3]]) -> (usize, Vec<(u32, u32)>, usize) {
     // Directed half-edge counts.
-    let mut half: HashMap<(u32, u32), u32> = HashMap::with_capacity(m.tris.len() * 3);
-    for t in &m.tris {
+    let mut half: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3);
+    for t in tris {
         for k in 0..3 {
             *half.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
         }
@@ -155,14 +183,18 @@ pub fn topology(m: &TriMesh) -> TopologyInfo {
             _ => non_manifold_edges += 1,
         }
     }
-    // Boundary loops: follow boundary half-edges (a → b); count cycles.
+    (undirected.len(), boundary_edges, non_manifold_edges)
+}
+
+/// Boundary loops: follow boundary half-edges (a → b) and count the walks.
+fn count_boundary_loops(boundary_edges: &[(u32, u32)]) -> usize {
     let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &(a, b) in &boundary_edges {
+    for &(a, b) in boundary_edges {
         next.entry(a).or_default().push(b);
     }
     let mut used: HashMap<(u32, u32), bool> = HashMap::new();
     let mut boundary_loops = 0;
-    for &(a, b) in &boundary_edges {
+    for &(a, b) in boundary_edges {
         if used.contains_key(&(a, b)) {
             continue;
         }
@@ -177,7 +209,12 @@ pub fn topology(m: &TriMesh) -> TopologyInfo {
         }
         let _ = x;
     }
-    // Fans per vertex: union faces around a vertex that share an edge at it.
+    boundary_loops
+}
+
+/// Vertices whose faces form more than one fan (faces around the vertex joined through an edge
+/// at it).
+fn count_non_manifold_vertices(m: &TriMesh) -> usize {
     let vf = m.vertex_faces();
     let mut non_manifold_vertices = 0;
     for (v, faces) in vf.iter().enumerate() {
@@ -218,7 +255,11 @@ pub fn topology(m: &TriMesh) -> TopologyInfo {
             non_manifold_vertices += 1;
         }
     }
-    // Components by union-find over vertices.
+    non_manifold_vertices
+}
+
+/// Connected components by union-find over vertices (an unused vertex is its own component).
+fn count_components(nv: usize, tris: &[[u32; 3]]) -> usize {
     let mut parent: Vec<u32> = (0..nv as u32).collect();
     fn root(p: &mut [u32], mut i: u32) -> u32 {
         while p[i as usize] != i {
@@ -227,7 +268,7 @@ pub fn topology(m: &TriMesh) -> TopologyInfo {
         }
         i
     }
-    for t in &m.tris {
+    for t in tris {
         let r0 = root(&mut parent, t[0]);
         for &v in &t[1..] {
             let r = root(&mut parent, v);
@@ -236,26 +277,7 @@ pub fn topology(m: &TriMesh) -> TopologyInfo {
             }
         }
     }
-    let components = (0..nv as u32).filter(|&i| root(&mut parent, i) == i).count();
-    let edges = undirected.len();
-    let chi = nv as i64 - edges as i64 + m.tris.len() as i64;
-    let genus = (components == 1
-        && boundary_loops == 0
-        && non_manifold_edges == 0
-        && non_manifold_vertices == 0
-        && (2 - chi) % 2 == 0)
-        .then_some((2 - chi) / 2);
-    TopologyInfo {
-        vertices: nv,
-        edges,
-        faces: m.tris.len(),
-        components,
-        boundary_loops,
-        non_manifold_edges,
-        non_manifold_vertices,
-        euler_characteristic: chi,
-        genus,
-    }
+    (0..nv as u32).filter(|&i| root(&mut parent, i) == i).count()
 }
 
 /// Refuses anything but a closed, connected, manifold, genus-0 surface, saying what was found.

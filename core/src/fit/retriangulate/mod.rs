@@ -11,12 +11,17 @@
 //!   consistent across faces and cannot lose its way when the path runs through a vertex.
 //! - A crossing within `snap_fraction` of an edge length from a free vertex snaps that vertex
 //!   onto the segment and makes it a chain vertex (instead of creating a sliver triangle).
-//! - When the walk fails (mesh boundary, crossing another curve's edge, no valid re-triangulation)
-//!   the fallback of §3.2 runs: a Dijkstra path between the ends, its inner vertices moved onto
-//!   the segment.
+//! - When the walk fails (mesh boundary, crossing another curve's edge, lost in a fold, no valid
+//!   re-triangulation) the segment waits until every other segment was walked, then the fallback
+//!   of §3.2 runs (a Dijkstra path between the ends, its inner vertices moved onto the segment:
+//!   [`dijkstra`]) if that turns no face over, else the route across faces split into a chain
+//!   ([`route`]), which exists whenever the realised curves do not separate the ends. A segment
+//!   with no route is reported as "separated" (crossing or tangled input), never dropped silently.
+//!
+//! Files: this one (the walk, the snapping, the order of segments and fallbacks), `fill.rs` (the
+//! ear-cut re-filling of a walked strip), `dijkstra.rs`, `route.rs`.
 
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashSet};
+use std::collections::HashSet;
 use std::hash::BuildHasherDefault;
 
 use serde::Serialize;
@@ -29,7 +34,12 @@ use crate::mesh::Point3;
 use super::curves::CurveNetwork;
 use super::trimesh::{IntHasher, IntMap, TriMesh};
 
+mod dijkstra;
+mod fill;
 mod route;
+
+use dijkstra::{dijkstra_project, Projected};
+use fill::retriangulate;
 
 type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
 
@@ -58,6 +68,11 @@ pub struct RetriStats {
     pub route_segments: usize,
     pub route_vertices: usize,
     pub route_vertices_on_segment: usize,
+    /// Route chains more than [`LONG_DETOUR`] times longer than their ends' distance: realised
+    /// curves blocked the straight way (crossing input, or curve vertices placed in a tangled
+    /// order by the fine stage) and the chain goes around them, so the regions next to it may
+    /// differ from the input's.
+    pub route_long_detours: usize,
     /// Which fallback realised which segment (the first 50).
     pub fallbacks: Vec<FallbackUse>,
     /// Segments that could not be realised at all.
@@ -108,6 +123,9 @@ enum Fallback {
     Route(usize),
 }
 
+/// A route chain longer than this × its ends' distance is counted as a long detour.
+pub const LONG_DETOUR: f64 = 3.0;
+
 /// Chain length over end-to-end distance.
 fn detour(mesh: &TriMesh, chain: &[u32]) -> f64 {
     let (Some(&a), Some(&b)) = (chain.first(), chain.last()) else { return 1.0 };
@@ -144,6 +162,7 @@ impl RetriStats {
             }
             Fallback::Route(n) => {
                 self.route_segments += 1;
+                self.route_long_detours += usize::from(detour > LONG_DETOUR);
                 self.route_vertices += n;
                 ("route", n)
             }
@@ -656,258 +675,6 @@ fn crossing(mesh: &TriMesh, cut: &Cut, l: u32, r: u32) -> (Point3, f64) {
     (add(pl, scale(sub(pr, pl), lam)), lam)
 }
 
-/// Replaces the strip `faces` between u and `end` by the edge u–end and an ear-cut filling of the
-/// polygons on either side. On failure the mesh is left as it was.
-fn retriangulate(mesh: &mut TriMesh, u: u32, end: u32, faces: &[u32], crossed: &[(u32, u32)]) -> bool {
-    let mut left: Vec<u32> = Vec::new();
-    let mut right: Vec<u32> = Vec::new();
-    for &(l, r) in crossed {
-        if left.last() != Some(&l) {
-            left.push(l);
-        }
-        if right.last() != Some(&r) {
-            right.push(r);
-        }
-    }
-    let mut all: Vec<u32> = left.iter().chain(&right).copied().collect();
-    all.push(u);
-    all.push(end);
-    let n_all = all.len();
-    all.sort_unstable();
-    all.dedup();
-    if all.len() != n_all || mesh.has_edge(u, end) {
-        return false; // the strip wraps around a vertex: not a simple region
-    }
-    let mut nr = [0.0; 3];
-    for &f in faces {
-        nr = add(nr, mesh.face_normal(f));
-    }
-    let nr = normalize(nr);
-    let e1 = normalize(sub(mesh.pos[end as usize], mesh.pos[u as usize]));
-    let e1 = normalize(sub(e1, scale(nr, dot(e1, nr))));
-    let e2 = cross(nr, e1);
-    if e1 == [0.0; 3] || nr == [0.0; 3] {
-        return false;
-    }
-    let mut left_poly = vec![u, end];
-    left_poly.extend(left.iter().rev());
-    let mut right_poly = vec![end, u];
-    right_poly.extend(right.iter());
-    let saved: Vec<[u32; 3]> = faces.iter().map(|&f| mesh.tris[f as usize]).collect();
-    for &f in faces {
-        mesh.remove_face(f);
-    }
-    let origin = mesh.pos[u as usize];
-    let new = ear_cut(mesh, &left_poly, origin, e1, e2).and_then(|mut a| {
-        ear_cut(mesh, &right_poly, origin, e1, e2).map(|b| {
-            a.extend(b);
-            a
-        })
-    });
-    let mut added = Vec::new();
-    let ok = match new {
-        Some(tris) if tris.len() == faces.len() => {
-            let mut ok = true;
-            for t in tris {
-                match mesh.add_face(t) {
-                    Ok(f) => added.push(f),
-                    Err(()) => {
-                        ok = false;
-                        break;
-                    }
-                }
-            }
-            ok
-        }
-        _ => false,
-    };
-    if !ok {
-        for f in added {
-            mesh.remove_face(f);
-        }
-        for t in saved {
-            let _ = mesh.add_face(t);
-        }
-    }
-    ok
-}
-
-/// Greedy ear cutting of a CCW polygon (in the e1/e2 frame), smallest angle first (Fig. 3.3).
-/// Refuses ears whose new diagonal already exists as a mesh edge.
-fn ear_cut(mesh: &TriMesh, poly: &[u32], origin: Point3, e1: Point3, e2: Point3) -> Option<Vec<[u32; 3]>> {
-    let p2: Vec<[f64; 2]> = poly
-        .iter()
-        .map(|&v| {
-            let d = sub(mesh.pos[v as usize], origin);
-            [dot(d, e1), dot(d, e2)]
-        })
-        .collect();
-    let scale2 = p2.iter().fold(0.0f64, |m, p| m.max(p[0].abs()).max(p[1].abs())).powi(2).max(1e-300);
-    let mut idx: Vec<usize> = (0..poly.len()).collect();
-    let mut out = Vec::with_capacity(poly.len().saturating_sub(2));
-    let mut diagonals: IntMap<(u32, u32), ()> = IntMap::default();
-    let cross2 =
-        |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-    while idx.len() > 3 {
-        let n = idx.len();
-        let mut best: Option<(usize, f64)> = None;
-        for k in 0..n {
-            let (ip, ic, inx) = (idx[(k + n - 1) % n], idx[k], idx[(k + 1) % n]);
-            let (pp, pc, pn) = (p2[ip], p2[ic], p2[inx]);
-            let area = cross2(pp, pc, pn);
-            if area <= 1e-12 * scale2 {
-                continue; // reflex or flat corner
-            }
-            let inside = idx.iter().any(|&j| {
-                j != ip && j != ic && j != inx && {
-                    let q = p2[j];
-                    cross2(pp, pc, q) >= 0.0 && cross2(pc, pn, q) >= 0.0 && cross2(pn, pp, q) >= 0.0
-                }
-            });
-            if inside {
-                continue;
-            }
-            let (vp, vn) = (poly[ip], poly[inx]);
-            if mesh.has_edge(vp, vn) || diagonals.contains_key(&(vp.min(vn), vp.max(vn))) {
-                continue;
-            }
-            let u = [pp[0] - pc[0], pp[1] - pc[1]];
-            let v = [pn[0] - pc[0], pn[1] - pc[1]];
-            let angle = (u[0] * v[1] - u[1] * v[0]).abs().atan2(u[0] * v[0] + u[1] * v[1]);
-            if best.is_none_or(|b| angle < b.1) {
-                best = Some((k, angle));
-            }
-        }
-        let (k, _) = best?;
-        let (ip, ic, inx) = (idx[(k + n - 1) % n], idx[k], idx[(k + 1) % n]);
-        out.push([poly[ip], poly[ic], poly[inx]]);
-        diagonals.insert((poly[ip].min(poly[inx]), poly[ip].max(poly[inx])), ());
-        idx.remove(k);
-    }
-    if idx.len() == 3 {
-        if cross2(p2[idx[0]], p2[idx[1]], p2[idx[2]]) <= 0.0 {
-            return None;
-        }
-        out.push([poly[idx[0]], poly[idx[1]], poly[idx[2]]]);
-    }
-    Some(out)
-}
-
-enum Projected {
-    Done(Vec<u32>),
-    /// A path exists but projecting it would turn a face over (nothing was moved).
-    WouldFlip,
-    NoPath,
-}
-
-/// §3.2 fallback: shortest edge path from `from` to `to` through free vertices, whose inner
-/// vertices are then moved onto the segment (spaced by their arc length along the path), unless
-/// that turns a face of their stars over.
-fn dijkstra_project(
-    mesh: &mut TriMesh,
-    from: u32,
-    to: u32,
-    on_curve: &[bool],
-    uv_moves: &mut Vec<super::uvs::UvMove>,
-) -> Projected {
-    match dijkstra_path(mesh, from, to, on_curve) {
-        None => Projected::NoPath,
-        Some((path, total)) => project_path(mesh, path, total, uv_moves),
-    }
-}
-
-fn dijkstra_path(mesh: &TriMesh, from: u32, to: u32, on_curve: &[bool]) -> Option<(Vec<u32>, f64)> {
-    let mut dist: IntMap<u32, f64> = IntMap::default();
-    let mut prev: IntMap<u32, u32> = IntMap::default();
-    let mut heap = BinaryHeap::new();
-    dist.insert(from, 0.0);
-    heap.push(Reverse((0u64, from)));
-    // A path much longer than the segment would drag far-away vertices onto it: give up instead.
-    let reach = 4.0 * mesh.len(from, to);
-    let mut pops = 0usize;
-    while let Some(Reverse((dbits, v))) = heap.pop() {
-        let dv = f64::from_bits(dbits);
-        if dv > *dist.get(&v).unwrap_or(&f64::INFINITY) {
-            continue;
-        }
-        if v == to {
-            break;
-        }
-        pops += 1;
-        if pops > 200_000 || dv > reach {
-            return None;
-        }
-        for &f in mesh.faces_of(v) {
-            for &nb in &mesh.tris[f as usize] {
-                if nb == v || (nb != to && on_curve[nb as usize]) {
-                    continue;
-                }
-                let nd = dv + mesh.len(v, nb);
-                if nd < *dist.get(&nb).unwrap_or(&f64::INFINITY) {
-                    dist.insert(nb, nd);
-                    prev.insert(nb, v);
-                    // Non-negative f64 bit patterns order like the values.
-                    heap.push(Reverse((nd.to_bits(), nb)));
-                }
-            }
-        }
-    }
-    let total = *dist.get(&to)?;
-    let mut path = vec![to];
-    let mut v = to;
-    while v != from {
-        v = *prev.get(&v)?;
-        path.push(v);
-    }
-    path.reverse();
-    Some((path, total))
-}
-
-fn project_path(
-    mesh: &mut TriMesh,
-    path: Vec<u32>,
-    total: f64,
-    uv_moves: &mut Vec<super::uvs::UvMove>,
-) -> Projected {
-    let (from, to) = (path[0], path[path.len() - 1]);
-    let (a, b) = (mesh.pos[from as usize], mesh.pos[to as usize]);
-    let mut acc = 0.0;
-    let old: Vec<Point3> = path.iter().map(|&v| mesh.pos[v as usize]).collect();
-    let mut targets = Vec::with_capacity(path.len());
-    for k in 1..path.len().saturating_sub(1) {
-        acc += crate::geometry::dist(old[k - 1], old[k]);
-        let frac = if total > 0.0 { acc / total } else { 0.5 };
-        let target = add(a, scale(sub(b, a), frac));
-        targets.push(target);
-    }
-    let inner = &path[1..path.len().saturating_sub(1)];
-    let mut stars: Vec<u32> = inner.iter().flat_map(|&v| mesh.faces_of(v).iter().copied()).collect();
-    stars.sort_unstable();
-    stars.dedup();
-    let normals: Vec<Point3> = stars.iter().map(|&f| mesh.face_normal(f)).collect();
-    for (&v, &t) in inner.iter().zip(&targets) {
-        mesh.pos[v as usize] = t;
-    }
-    let turned = stars.iter().zip(&normals).any(|(&f, &n0)| {
-        let n1 = mesh.face_normal(f);
-        dot(n0, n1) <= 0.0 || norm(n1) <= 1e-12 * norm(n0)
-    });
-    for (&v, &p) in inner.iter().zip(&old[1..]) {
-        mesh.pos[v as usize] = p;
-    }
-    if turned {
-        return Projected::WouldFlip;
-    }
-    // Located on the mesh before any path vertex moves.
-    for (&v, &t) in inner.iter().zip(&targets) {
-        uv_moves.extend(super::uvs::record(mesh, v, t));
-    }
-    for (&v, t) in inner.iter().zip(targets) {
-        mesh.pos[v as usize] = t;
-    }
-    Projected::Done(path)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1066,6 +833,7 @@ mod tests {
         let used: Vec<_> = r.stats.fallbacks.iter().filter(|f| f.segment == blocked).collect();
         assert_eq!(used.len(), 1);
         assert!(used[0].detour >= 7.2 / 37f64.sqrt(), "{}", used[0].detour);
+        assert_eq!(r.stats.route_long_detours, usize::from(used[0].detour > LONG_DETOUR));
         let ys = crossings_at_x(&mesh, &r.chains[blocked], 5.0);
         assert!(!ys.is_empty() && ys.iter().all(|&y| y <= 3.0 + 1e-9 || y >= 7.0 - 1e-9), "{ys:?}");
     }

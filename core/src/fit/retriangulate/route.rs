@@ -64,6 +64,10 @@ fn nearest_fraction(p: Point3, q: Point3, a: Point3, b: Point3) -> f64 {
     s.clamp(END_MARGIN, 1.0 - END_MARGIN)
 }
 
+/// Per face reached: best distance, where it was entered, and the (previous face, crossing) it
+/// was entered by (none for the start's star).
+type Reached = (f64, Point3, Option<(u32, Crossing)>);
+
 /// The shortest route of crossings from `from` to `to` (neither on the other's star), avoiding
 /// `locked` edges; `a`–`b` is the straight segment the crossings stay near. At most `budget`
 /// faces are settled.
@@ -76,8 +80,7 @@ pub(super) fn find(
     budget: usize,
 ) -> Result<Vec<Crossing>, NoRoute> {
     let is_locked = |x: u32, y: u32| locked.contains(&(x.min(y), x.max(y)));
-    // Per face: best distance, where it was entered, and the crossing it was entered by.
-    let mut best: IntMap<u32, (f64, Point3, Option<(u32, Crossing)>)> = IntMap::default();
+    let mut best: IntMap<u32, Reached> = IntMap::default();
     let mut heap = BinaryHeap::new();
     let start = mesh.pos[from as usize];
     for &f in mesh.faces_of(from) {
