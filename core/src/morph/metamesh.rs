@@ -114,10 +114,16 @@ fn pseudo_angle(x: f64, y: f64) -> f64 {
     }
 }
 
-/// f64 with a total order, as a sort key.
-#[derive(PartialEq, PartialOrd)]
+/// f64 with a total order, as a sort key. `PartialOrd` agrees with `Ord` (a derived one would
+/// not: the sort compares through it, and clippy refuses the mismatch).
+#[derive(PartialEq)]
 struct Angle(f64);
 impl Eq for Angle {}
+impl PartialOrd for Angle {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
 impl Ord for Angle {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
         self.0.total_cmp(&o.0)
