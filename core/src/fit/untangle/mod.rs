@@ -23,6 +23,7 @@ use crate::mesh::Point3;
 use super::trimesh::{IntHasher, TriMesh};
 use super::uvs::{self, UvMove};
 
+mod energy;
 mod patch;
 
 /// A face counts as folded when its normal is within this cosine of perpendicular to the reference
@@ -264,6 +265,48 @@ mod tests {
         assert_eq!(s.folded_after, 0);
         // The boundary ring did not move.
         assert_eq!(mesh.pos[0], [1.0, 0.0, 0.0]);
+    }
+
+    /// A 10×10 plane grid (reference +z) whose inner 4×4 block of vertices is mirrored through
+    /// the block's centre line x = 4.5 (vertex (i, j) goes to (9 − i, j)): every face of the block
+    /// is turned over and the block's rows cross each other, so no single vertex has an unfolded
+    /// position given its (equally folded) neighbours. A fixed vertex sits next to the block (a
+    /// curve vertex). Truth: the grid itself is fold-free with the same fixed vertices, so a
+    /// fold-free answer exists; every vertex must stay in the plane and fixed ones must not move.
+    #[test]
+    fn a_mirrored_block_is_untangled_as_a_whole() {
+        let n = 10usize;
+        let g = crate::shapes::grid(n, n, 1.0, false);
+        let tris = crate::shapes::fan_triangles(&g.faces);
+        let id = |i: usize, j: usize| j * (n + 1) + i;
+        let mut pos = g.positions.clone();
+        for j in 3..=6 {
+            for i in 3..=6 {
+                pos[id(i, j)][0] = 9.0 - pos[id(i, j)][0];
+            }
+        }
+        let mut fixed: Vec<bool> = (0..pos.len())
+            .map(|v| v % (n + 1) == 0 || v % (n + 1) == n || v <= n || v >= n * (n + 1))
+            .collect();
+        fixed[id(2, 4)] = true;
+        let before = pos.clone();
+        let mut mesh = TriMesh::new(pos, tris).unwrap();
+        let reference = vec![[0.0, 0.0, 1.0]; mesh.pos.len()];
+        let s = untangle(&mut mesh, &reference, &fixed, &EdgeSet::default(), 8);
+        assert!(s.folded_before >= 9, "{s:?}");
+        assert!(s.patches_solved >= 1, "the local fixes alone were enough: {s:?}");
+        assert_eq!(s.folded_after, 0, "{s:?}");
+        for (v, p) in mesh.pos.iter().enumerate() {
+            assert!(p[2].abs() < 1e-12, "vertex {v} left the plane: {p:?}");
+            if fixed[v] {
+                assert_eq!(*p, before[v]);
+            }
+        }
+        for f in mesh.alive_faces() {
+            let t = mesh.tris[f as usize];
+            let c = triangle_cross(mesh.pos[t[0] as usize], mesh.pos[t[1] as usize], mesh.pos[t[2] as usize]);
+            assert!(c[2] > 0.0, "face {t:?} still turned over");
+        }
     }
 
     #[test]

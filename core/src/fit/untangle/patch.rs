@@ -19,13 +19,13 @@
 
 use std::collections::HashMap;
 
-use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub};
+use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub, triangle_cross};
 use crate::mesh::Point3;
 
 use super::super::smooth::min_angle_quality;
 use super::super::trimesh::TriMesh;
 use super::super::uvs::{self, UvMove};
-use super::{Ctx, MIN_COS};
+use super::{energy, Ctx, MIN_COS};
 
 /// Rings added around a group of folded faces, tried in order until one works.
 const MAX_RINGS: usize = 8;
@@ -231,12 +231,6 @@ fn solve(
     }
     let solved = tutte(&coords, &free, &nbrs);
     let lift = |c: [f64; 3]| add(origin, add(add(scale(u, c[0]), scale(w, c[1])), scale(n, c[2])));
-    let mut cand: Vec<Point3> = verts.iter().map(|&v| mesh.pos[v as usize]).collect();
-    for i in 0..verts.len() {
-        if free[i] {
-            cand[i] = lift(solved[i]);
-        }
-    }
     let q_before =
         patch.iter().map(|&f| quality(mesh.tris[f as usize], |v| mesh.pos[v as usize])).fold(1.0, f64::min);
     let folded_before = patch.iter().filter(|&&f| ctx.folded(mesh, mesh.tris[f as usize])).count();
@@ -246,23 +240,72 @@ fn solve(
         let q = patch.iter().map(|&f| quality(mesh.tris[f as usize], p)).fold(1.0, f64::min);
         (left, q)
     };
-    // Drop the moved vertices onto the old surface (closest point on the patch's faces).
-    let mut projected = cand.clone();
-    for i in 0..verts.len() {
-        if free[i] {
-            projected[i] = closest_on_patch(mesh, patch, cand[i]);
+    // A layout in the plane → 3D positions (heights of the membrane), then the better of those and
+    // their drop onto the old surface: (folded left, quality, positions).
+    let place = |layout: &[[f64; 2]]| -> (usize, f64, Vec<Point3>) {
+        let mut cand: Vec<Point3> = verts.iter().map(|&v| mesh.pos[v as usize]).collect();
+        for i in 0..verts.len() {
+            if free[i] {
+                cand[i] = lift([layout[i][0], layout[i][1], solved[i][2]]);
+            }
+        }
+        let mut projected = cand.clone();
+        for i in 0..verts.len() {
+            if free[i] {
+                projected[i] = closest_on_patch(mesh, patch, cand[i]);
+            }
+        }
+        let (left_p, q_p) = eval(&projected);
+        let (left_m, q_m) = eval(&cand);
+        if left_p <= left_m && q_p >= q_before.min(q_m) {
+            (left_p, q_p, projected)
+        } else {
+            (left_m, q_m, cand)
+        }
+    };
+    // 1. Tutte's map.
+    let tutte_layout: Vec<[f64; 2]> = solved.iter().map(|c| [c[0], c[1]]).collect();
+    let mut best = place(&tutte_layout);
+    // 2. Where it leaves folds or slivers: the barrier energy, from the layout as it is.
+    if best.0 > 0 || best.1 < q_before {
+        let mut layout: Vec<[f64; 2]> = coords.iter().map(|c| [c[0], c[1]]).collect();
+        let areas: Vec<f64> = patch
+            .iter()
+            .map(|&f| {
+                let t = mesh.tris[f as usize];
+                0.5 * norm2(triangle_cross(
+                    mesh.pos[t[0] as usize],
+                    mesh.pos[t[1] as usize],
+                    mesh.pos[t[2] as usize],
+                ))
+                .sqrt()
+            })
+            .collect();
+        let mean_area = areas.iter().sum::<f64>() / areas.len().max(1) as f64;
+        let refs: Vec<energy::RefTri> = patch
+            .iter()
+            .map(|&f| {
+                let t = mesh.tris[f as usize];
+                energy::RefTri::new(t.map(|v| index[&v]), t.map(|v| mesh.pos[v as usize]), 1e-2 * mean_area)
+            })
+            .collect();
+        let mut tris_of: Vec<Vec<usize>> = vec![Vec::new(); verts.len()];
+        for (k, r) in refs.iter().enumerate() {
+            for &c in &r.c {
+                tris_of[c].push(k);
+            }
+        }
+        energy::untangle_2d(&mut layout, &free, &refs, &tris_of, mean_area.sqrt(), 40);
+        let e = place(&layout);
+        if e.0 < best.0 || (e.0 == best.0 && e.1 > best.1) {
+            best = e;
         }
     }
-    let (left_p, q_p) = eval(&projected);
-    let (left_m, q_m) = eval(&cand);
-    let choice = if left_p <= left_m && q_p >= q_before.min(q_m) {
-        Some((left_p, projected))
-    } else if q_m >= q_before {
-        Some((left_m, cand))
-    } else {
-        None
-    };
-    let (left, chosen) = choice.ok_or("worse angles")?;
+    let (left, q, chosen) = best;
+    // Never below the patch's own smallest angle (so the mesh's smallest angle cannot drop).
+    if q < q_before {
+        return Err("worse angles");
+    }
     if left >= folded_before {
         return Err("no better");
     }
