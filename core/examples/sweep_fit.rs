@@ -13,10 +13,10 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
+use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
 use meshwork_core::fit::testdata::{
     bend, boundary_vertices, crossing_pairs, plane_sections, section_regions, thin_network,
 };
-use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
 use meshwork_core::fit::{run, CoplanarCentres, FitParams};
 use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
@@ -143,9 +143,14 @@ fn euler_regions(template: &Mesh, curves: &Mesh, params: &FitParams) -> Option<S
         parent[ra] = rb;
     }
     let used: std::collections::HashSet<u32> = segs.iter().flat_map(|&(a, b)| [a, b]).collect();
-    let comps: std::collections::HashSet<usize> = used.iter().map(|&v| root(&mut parent, v as usize)).collect();
+    let comps: std::collections::HashSet<usize> =
+        used.iter().map(|&v| root(&mut parent, v as usize)).collect();
     let planar = segs.len() + comps.len() + 1 - used.len();
-    Some(if genus == 0 { planar.to_string() } else { format!("{}-{planar}", planar.saturating_sub(2 * genus)) })
+    Some(if genus == 0 {
+        planar.to_string()
+    } else {
+        format!("{}-{planar}", planar.saturating_sub(2 * genus))
+    })
 }
 
 fn main() {

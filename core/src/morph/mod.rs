@@ -94,7 +94,7 @@ pub enum Correspondence {
 pub struct MorphParams {
     /// Frames of the animation (keyframes in the GLB; meshes with `output_frames`), ≥ 2.
     pub frames: usize,
-    /// Length of the whole animation in seconds.
+    /// Length of the whole animation in seconds, in [1e-3, 1e7] (keyframe times are f32 in the GLB).
     pub duration_seconds: f64,
     /// Feature points: each entry lists one vertex index per input (indices as in the input
     /// files), e.g. `[[12, 407], [88, 1093]]` for two inputs. Paired points meet on the sphere, so

@@ -56,21 +56,6 @@ pub(super) fn untangle_patches(mesh: &mut TriMesh, ctx: &Ctx) -> PatchPass {
         for &g in &group {
             seen.insert(g, ());
         }
-        if std::env::var("FIT_UNTANGLE_DEBUG").is_ok() {
-            for &g in &group {
-                let t = mesh.tris[g as usize];
-                let fx: Vec<bool> = t.iter().map(|&v| ctx.fixed[v as usize]).collect();
-                let lk: Vec<bool> = (0..3).map(|k| ctx.locked(t[k], t[(k + 1) % 3])).collect();
-                let q = quality(t, |v| mesh.pos[v as usize]).sqrt().asin().to_degrees();
-                let rn: Vec<f64> = (0..3)
-                    .map(|k| dot(ctx.reference[t[k] as usize], ctx.reference[t[(k + 1) % 3] as usize]))
-                    .collect();
-                eprintln!(
-                    "  face {g} {t:?} fixed {fx:?} locked {lk:?} score {:.3} minang {q:.2} refdots {rn:.2?}",
-                    ctx.score(t, |v| mesh.pos[v as usize])
-                );
-            }
-        }
         let mut patch = group.clone();
         let mut in_patch: HashMap<u32, ()> = patch.iter().map(|&g| (g, ())).collect();
         let mut best: Option<(usize, Vec<(u32, Point3)>)> = None;
@@ -81,14 +66,6 @@ pub(super) fn untangle_patches(mesh: &mut TriMesh, ctx: &Ctx) -> PatchPass {
                 break;
             }
             let got = solve(mesh, ctx, &patch, &in_patch);
-            if std::env::var("FIT_UNTANGLE_DEBUG").is_ok() {
-                eprintln!(
-                    "group {} faces, patch {}: {:?}",
-                    group.len(),
-                    patch.len(),
-                    got.as_ref().map(|g| g.0).map_err(|e| *e)
-                );
-            }
             let Ok((left, moves)) = got else { continue };
             if left == 0 {
                 best = Some((0, moves));
