@@ -15,12 +15,13 @@ use std::time::Instant;
 
 use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
 use meshwork_core::fit::testdata::{
-    bend, boundary_vertices, crossing_pairs, plane_sections, section_regions, thin_network,
+    bend, boundary_vertices, crossing_pairs, plane_sections, section_regions, sweep_planes, thin_network,
+    to_unit_box,
 };
 use meshwork_core::fit::{run, CoplanarCentres, FitParams};
 use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
-use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::mesh::Mesh;
 use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::shapes::subdivide_midpoint;
 use meshwork_core::spatial::Bvh;
@@ -34,33 +35,9 @@ fn load(name: &str) -> Option<Mesh> {
     let raw = read(&bytes, &ReadOptions::default()).ok()?.mesh;
     let params = RepairParams { fill_holes: false, ..Default::default() };
     let mut m = repair::run(raw, &params, &Progress::new()).ok()?.meshes.remove(0);
-    let bb = Aabb::of(&m.positions)?;
-    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-    for p in &mut m.positions {
-        for k in 0..3 {
-            p[k] = (p[k] - bb.min[k]) / side;
-        }
-    }
+    Aabb::of(&m.positions)?;
+    to_unit_box(&mut m);
     Some(m)
-}
-
-/// Four sections across the longest axis and one along each other axis, at offsets chosen off
-/// round fractions so no plane passes through a vertex of the (scaled) mesh by accident.
-fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
-    let bb = Aabb::of(&m.positions).expect("mesh has vertices");
-    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
-    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap_or(1);
-    let axis = |k: usize| {
-        let mut n = [0.0; 3];
-        n[k] = 1.0;
-        n
-    };
-    let mut p: Vec<(Point3, f64)> =
-        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
-    for k in (0..3).filter(|&k| k != long) {
-        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
-    }
-    p
 }
 
 /// Max distance of `out`'s vertices to the bent truth surface (exact closest points, BVH),
@@ -176,7 +153,7 @@ fn main() {
             println!("{name:<16} SKIP (not readable or not repairable)");
             continue;
         };
-        let planes = planes(&m);
+        let planes = sweep_planes(&m);
         let expected = section_regions(&m, &planes);
         let sections = thin_network(&plane_sections(&m, &planes), 2);
         let template = subdivide_midpoint(&m, 1);

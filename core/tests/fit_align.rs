@@ -5,7 +5,9 @@
 //! copy by `testdata::section_regions`, independent of the fit).
 
 use meshwork_core::fit::curves::CurveNetwork;
-use meshwork_core::fit::testdata::{bend, plane_sections, section_regions, thin_network};
+use meshwork_core::fit::testdata::{
+    bend, plane_sections, section_regions, sweep_planes, thin_network, to_unit_box,
+};
 use meshwork_core::fit::{align, run, FitParams};
 use meshwork_core::geometry::{dist, Aabb};
 use meshwork_core::io::{read, ReadOptions};
@@ -22,32 +24,8 @@ fn shared(name: &str) -> Mesh {
             .find_map(|p| std::fs::read(p).ok())
             .expect("mesh in ../shared/meshes");
     let mut m = read(&bytes, &ReadOptions::default()).expect("read").mesh;
-    let bb = Aabb::of(&m.positions).unwrap();
-    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-    for p in &mut m.positions {
-        for k in 0..3 {
-            p[k] = (p[k] - bb.min[k]) / side;
-        }
-    }
+    to_unit_box(&mut m);
     m
-}
-
-/// Four sections across the longest axis, one along each other axis (off round offsets).
-fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
-    let bb = Aabb::of(&m.positions).unwrap();
-    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
-    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap();
-    let axis = |k: usize| {
-        let mut n = [0.0; 3];
-        n[k] = 1.0;
-        n
-    };
-    let mut p: Vec<(Point3, f64)> =
-        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
-    for k in (0..3).filter(|&k| k != long) {
-        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
-    }
-    p
 }
 
 fn rms(a: &[Point3], b: &[Point3]) -> f64 {
@@ -56,7 +34,7 @@ fn rms(a: &[Point3], b: &[Point3]) -> f64 {
 
 /// Bent sections of `m` (every second section point kept).
 fn bent_sections(m: &Mesh) -> Mesh {
-    let mut curves = thin_network(&plane_sections(m, &planes(m)), 2);
+    let mut curves = thin_network(&plane_sections(m, &sweep_planes(m)), 2);
     for p in &mut curves.positions {
         *p = bend(*p, 1.0);
     }
@@ -90,7 +68,7 @@ fn automatic_alignment_follows_a_bend_better_than_any_similarity() {
 #[test]
 fn automatic_alignment_fit_finds_every_region() {
     let m = shared("spot");
-    let expected = section_regions(&m, &planes(&m));
+    let expected = section_regions(&m, &sweep_planes(&m));
     let template = subdivide_midpoint(&m, 1);
     let params = FitParams::default(); // no pairs: PCA + ICP + warp
     let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
@@ -113,7 +91,7 @@ fn pairs_on_one_line_of_a_flat_template_fall_back_to_a_similarity() {
     use meshwork_core::fit::CoplanarCentres;
     use meshwork_core::spatial::Bvh;
     let m = shared("woody");
-    let sections = thin_network(&plane_sections(&m, &planes(&m)), 2);
+    let sections = thin_network(&plane_sections(&m, &sweep_planes(&m)), 2);
     let template = subdivide_midpoint(&m, 1);
     let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
     // The premise, checked independently: the pairs' template vertices are (nearly) collinear.

@@ -9,11 +9,12 @@
 //! chain". On main before the route fallback: spot 99.28 % of segments, 19 of 22 regions;
 //! fandisk 99.86 %, 15 of 16.
 
-use meshwork_core::fit::testdata::{bend, plane_sections, section_regions, thin_network};
+use meshwork_core::fit::testdata::{
+    bend, plane_sections, section_regions, sweep_planes, thin_network, to_unit_box,
+};
 use meshwork_core::fit::{run, FitParams};
-use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
-use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::mesh::Mesh;
 use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::shapes::subdivide_midpoint;
 use meshwork_core::Progress;
@@ -24,37 +25,13 @@ fn load(name: &str) -> Mesh {
     let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
     let params = RepairParams { fill_holes: false, ..Default::default() };
     let mut m = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
-    let bb = Aabb::of(&m.positions).unwrap();
-    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-    for p in &mut m.positions {
-        for k in 0..3 {
-            p[k] = (p[k] - bb.min[k]) / side;
-        }
-    }
+    to_unit_box(&mut m);
     m
-}
-
-/// The sweep's planes: four across the longest axis, one along each other axis.
-fn planes(m: &Mesh) -> Vec<(Point3, f64)> {
-    let bb = Aabb::of(&m.positions).unwrap();
-    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
-    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap();
-    let axis = |k: usize| {
-        let mut n = [0.0; 3];
-        n[k] = 1.0;
-        n
-    };
-    let mut p: Vec<(Point3, f64)> =
-        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
-    for k in (0..3).filter(|&k| k != long) {
-        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
-    }
-    p
 }
 
 fn fit_auto(name: &str) {
     let m = load(name);
-    let planes = planes(&m);
+    let planes = sweep_planes(&m);
     let expected = section_regions(&m, &planes);
     let mut curves = thin_network(&plane_sections(&m, &planes), 2);
     for p in &mut curves.positions {

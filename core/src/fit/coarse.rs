@@ -26,6 +26,13 @@ pub struct CoarseReport {
     pub warp: Option<align::WarpReport>,
 }
 
+impl CoarseReport {
+    /// (curve point, template vertex) of every user pair, the points the later stages hold fixed.
+    pub fn pair_fixed(&self, pairs: &[FitPair]) -> Vec<(u32, u32)> {
+        self.pair_curve_points.iter().zip(pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect()
+    }
+}
+
 /// Iterations per degree of the smooth warp after the ICP (each: one closest-point pass).
 const WARP_ITERATIONS: u32 = 30;
 

@@ -101,8 +101,7 @@ fn fine_fit_inserted(
     parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
 ) -> Result<Fine> {
-    let pair_fixed: Vec<(u32, u32)> =
-        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let pair_fixed = coarse.pair_fixed(&params.pairs);
     let clock = std::time::Instant::now();
     let mut steps_ms = [0.0; 4];
     let mut lap = |k: usize| {
@@ -215,8 +214,7 @@ fn fine_fit(
     parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
 ) -> Result<Fine> {
-    let pair_fixed: Vec<(u32, u32)> =
-        coarse.pair_curve_points.iter().zip(&params.pairs).map(|(&p, pr)| (p, pr.template_vertex)).collect();
+    let pair_fixed = coarse.pair_fixed(&params.pairs);
     let nv0 = pos.len() - parents.len();
     let mut flagged_per_round = Vec::new();
     let mut faces_added = 0;

@@ -98,12 +98,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
     let fine = stages.run(progress, "fine", || {
         let clock = std::time::Instant::now();
-        let pair_fixed: Vec<(u32, u32)> = coarse
-            .pair_curve_points
-            .iter()
-            .zip(&params.pairs)
-            .map(|(&p, pr)| (p, pr.template_vertex))
-            .collect();
+        let pair_fixed = coarse.pair_fixed(&params.pairs);
         let levels = params.approach_levels as usize;
         let limit = params.max_curve_distance * template_diag;
         let approach =

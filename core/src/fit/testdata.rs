@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use crate::geometry::{add, dot, scale, sub};
+use crate::geometry::{add, dot, scale, sub, Aabb};
 use crate::mesh::{Mesh, Point3};
 use crate::shapes::{fan_triangles, subdivide_midpoint};
 
@@ -422,4 +422,39 @@ pub fn jitter(curves: &mut Mesh, amplitude: f64, seed: u64, keep: &[u32]) {
 pub fn great_circles(r: f64, n: usize, phases: [f64; 3]) -> Vec<Vec<Point3>> {
     let (o, x, y, z) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
     vec![circle(o, x, y, r, n, phases[0]), circle(o, x, z, r, n, phases[1]), circle(o, y, z, r, n, phases[2])]
+}
+
+/// Moves and scales `m` so its bounding box has its min corner at 0 and its longest side 1 (the fit
+/// sweep's frame, so plane offsets and tolerances mean the same on every mesh).
+pub fn to_unit_box(m: &mut Mesh) {
+    let Some(bb) = Aabb::of(&m.positions) else { return };
+    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+    if side <= 0.0 {
+        return;
+    }
+    for p in &mut m.positions {
+        for k in 0..3 {
+            p[k] = (p[k] - bb.min[k]) / side;
+        }
+    }
+}
+
+/// The fit sweep's planes: four sections across the longest axis and one along each other axis, at
+/// offsets off round fractions so no plane passes through a vertex of a scaled mesh by accident.
+/// Empty for a mesh without vertices.
+pub fn sweep_planes(m: &Mesh) -> Vec<(Point3, f64)> {
+    let Some(bb) = Aabb::of(&m.positions) else { return Vec::new() };
+    let ext: Vec<f64> = (0..3).map(|k| bb.max[k] - bb.min[k]).collect();
+    let long = (0..3).max_by(|&a, &b| ext[a].total_cmp(&ext[b])).unwrap_or(0);
+    let axis = |k: usize| {
+        let mut n = [0.0; 3];
+        n[k] = 1.0;
+        n
+    };
+    let mut p: Vec<(Point3, f64)> =
+        [0.2513, 0.4017, 0.5521, 0.7019].iter().map(|f| (axis(long), bb.min[long] + f * ext[long])).collect();
+    for k in (0..3).filter(|&k| k != long) {
+        p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
+    }
+    p
 }
