@@ -281,6 +281,30 @@ fn diagnose(c: &Case, out: &Mesh, report: &serde_json::Value) {
             other += 1;
             "other"
         };
+        if kind == "fold" && std::env::var("FIT_FOLDS").is_ok() {
+            let mut curve_edge: std::collections::HashSet<(u32, u32)> = Default::default();
+            for ch in &out.curves {
+                for w in ch.windows(2) {
+                    curve_edge.insert((w[0].min(w[1]), w[0].max(w[1])));
+                }
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for &g in &by_edge[&(a.min(b), a.max(b))] {
+                    if g != f {
+                        let ang = dot(n, normal(faces[g])).clamp(-1.0, 1.0).acos().to_degrees();
+                        println!(
+                            "    edge {a}-{b} curve {} neighbour {g} {:?} angle {ang:.1}",
+                            curve_edge.contains(&(a.min(b), a.max(b))),
+                            faces[g]
+                        );
+                    }
+                }
+            }
+            for &v in &t {
+                println!("    corner {v} {:?} curve {}", pos[v as usize], on_curve[v as usize]);
+            }
+        }
         if std::env::var("FIT_CORNERS").is_ok() {
             for &v in &t {
                 let q = pos[v as usize];
