@@ -182,131 +182,201 @@ pub(crate) fn push_vertex(mesh: &mut Mesh, p: Point3, like: &[u32]) -> u32 {
 }
 
 /// The `repair` job.
-pub fn run(mut mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Output> {
+pub fn run(mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Output> {
     params.check()?;
     mesh.check()?;
     let mut stages = Stages::new();
     let input = stages.run(progress, "validate_input", || Ok(validate::analyze(&mesh)))?;
-    let mut vmap = VertexMap::identity(mesh.positions.len());
-    let mut steps = serde_json::Map::new();
-    let diag = input.bbox_diagonal;
+    let mut r = Repairing {
+        vmap: VertexMap::identity(mesh.positions.len()),
+        mesh,
+        stages,
+        progress,
+        steps: serde_json::Map::new(),
+        dirty: false,
+        holes: None,
+    };
+    mend_topology(&mut r, params, &input)?;
+    close_and_compact(&mut r, params, &input)?;
 
-    // `dirty`: the faces changed since `input` was analysed. While false, a step whose problem the
-    // input report shows absent is skipped (said so in its report) instead of rebuilding topology.
-    let mut dirty = false;
-    let skipped = |why: &str| serde_json::json!({ "skipped": why });
-    if params.weld {
-        let r =
-            stages.run(progress, "weld", || weld::weld(&mut mesh, params.weld_tolerance * diag, progress))?;
-        dirty |= r.merged_vertices > 0;
-        steps.insert("weld".into(), to_json(&r));
-    }
-    if params.remove_degenerate || params.remove_duplicates {
-        let r = stages.run(progress, "clean", || {
-            Ok(clean::clean(&mut mesh, params.remove_degenerate, params.remove_duplicates, diag))
-        })?;
-        dirty |=
-            r.collapsed_corners + r.dropped_repeated_index + r.dropped_zero_area + r.dropped_duplicates > 0;
-        steps.insert("clean".into(), to_json(&r));
-    }
-    if params.non_manifold != NonManifoldMode::Keep {
-        if !dirty && input.non_manifold_edges == 0 && input.non_manifold_vertices == 0 {
-            steps.insert("non_manifold".into(), skipped("input has no non-manifold edges or vertices"));
-        } else {
-            let r = stages.run(progress, "non_manifold", || {
-                nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
-            })?;
-            dirty |= r.vertices_added + r.faces_removed > 0;
-            steps.insert("non_manifold".into(), to_json(&r));
-        }
-    }
-    if params.orient {
-        if !dirty && input.inconsistent_orientation == 0 {
-            steps.insert("orient".into(), skipped("input is consistently oriented"));
-        } else {
-            let r = stages.run(progress, "orient", || Ok(orient::make_consistent(&mut mesh)))?;
-            dirty |= r.faces_flipped > 0;
-            steps.insert("orient".into(), to_json(&r));
-        }
-    }
-    if params.min_component_faces > 0 || params.keep_largest {
-        let r = stages.run(progress, "components", || {
-            Ok(components::remove_small(&mut mesh, params.min_component_faces, params.keep_largest))
-        })?;
-        dirty |= r.faces_removed > 0;
-        steps.insert("components".into(), to_json(&r));
-    }
-    let mut holes_report = None;
-    if params.fill_holes {
-        if !dirty && input.boundary_edges == 0 {
-            steps.insert("fill_holes".into(), skipped("input has no boundary"));
-        } else {
-            let r = stages.run(progress, "fill_holes", || {
-                holes::fill(&mut mesh, &holes::FillOptions::from(params), progress)
-            })?;
-            dirty |= r.filled > 0;
-            steps.insert("fill_holes".into(), to_json(&r));
-            // A filled hole that touched a skipped one at a vertex leaves a closed fan next to an
-            // open one there (a non-manifold vertex the fill created): resolve those the same way.
-            if r.filled > 0 && params.non_manifold != NonManifoldMode::Keep {
-                let n = stages.run(progress, "non_manifold_after_fill", || {
-                    nonmanifold::resolve(&mut mesh, params.non_manifold, progress)
-                })?;
-                steps.insert("non_manifold_after_fill".into(), to_json(&n));
-            }
-            holes_report = Some(r);
-        }
-    }
-    if params.orient && params.outward {
-        if !dirty && input.components == 1 && input.volume.is_some_and(|v| v > 0.0) {
-            steps.insert("outward".into(), skipped("input is one closed component with positive volume"));
-        } else {
-            let r = stages.run(progress, "outward", || Ok(orient::outward(&mut mesh)))?;
-            dirty |= r.components_flipped > 0;
-            steps.insert("outward".into(), to_json(&r));
-        }
-    }
-    if params.remove_unreferenced {
-        let r = stages.run(progress, "compact", || Ok(clean::compact(&mut mesh)))?;
-        dirty |= r.removed_vertices > 0;
-        vmap.then(&r.map);
-        steps.insert("unreferenced".into(), to_json(&r));
-    }
-
-    let out = if dirty {
-        stages.run(progress, "validate_output", || Ok(validate::analyze(&mesh)))?
+    let out = if r.dirty {
+        let mesh = &r.mesh;
+        r.stages.run(progress, "validate_output", || Ok(validate::analyze(mesh)))?
     } else {
         input.clone()
     };
-    let why = why_not(&out, holes_report.as_ref(), params);
+    let why = why_not(&out, r.holes.as_ref(), params);
     if params.require_manifold && !(out.manifold && out.pinch_vertices == 0) {
         return Err(Error::Topology(format!("repaired mesh is not manifold: {}", why.join("; "))));
     }
-    let kept = vmap.map.iter().filter(|&&m| m != NONE).count();
+    let report = job_report(&r, &input, &out, why, params.report_vertex_map);
+    Ok(Output { meshes: vec![r.mesh], report, ..Default::default() })
+}
+
+/// The repair in progress: the mesh, the timings, each step's report (or why it was skipped),
+/// where every input vertex went, and `dirty`, whether the faces changed since the input was
+/// analysed. While `dirty` is false, a step whose problem the input report shows absent is
+/// skipped (said so in its report) instead of rebuilding topology.
+struct Repairing<'a> {
+    mesh: Mesh,
+    stages: Stages,
+    progress: &'a Progress,
+    steps: serde_json::Map<String, serde_json::Value>,
+    vmap: VertexMap,
+    dirty: bool,
+    /// The hole filling's report, for the `why_not` of an output that is still open.
+    holes: Option<holes::FillReport>,
+}
+
+impl Repairing<'_> {
+    /// Runs `f` on the mesh as the timed stage `stage`, records its report under `key`, and
+    /// marks the faces changed when `changed` says it changed them.
+    fn step<R: Serialize>(
+        &mut self,
+        stage: &str,
+        key: &str,
+        f: impl FnOnce(&mut Mesh, &Progress) -> Result<R>,
+        changed: impl FnOnce(&R) -> bool,
+    ) -> Result<R> {
+        let (mesh, progress) = (&mut self.mesh, self.progress);
+        let r = self.stages.run(progress, stage, || f(mesh, progress))?;
+        self.dirty |= changed(&r);
+        self.steps.insert(key.into(), to_json(&r));
+        Ok(r)
+    }
+
+    fn skip(&mut self, key: &str, why: &str) {
+        self.steps.insert(key.into(), serde_json::json!({ "skipped": why }));
+    }
+}
+
+/// Steps 1–5: weld, clean, non-manifold parts, orientation, small components.
+fn mend_topology(r: &mut Repairing, params: &RepairParams, input: &validate::Report) -> Result<()> {
+    let diag = input.bbox_diagonal;
+    if params.weld {
+        r.step(
+            "weld",
+            "weld",
+            |m, p| weld::weld(m, params.weld_tolerance * diag, p),
+            |w| w.merged_vertices > 0,
+        )?;
+    }
+    if params.remove_degenerate || params.remove_duplicates {
+        r.step(
+            "clean",
+            "clean",
+            |m, _| Ok(clean::clean(m, params.remove_degenerate, params.remove_duplicates, diag)),
+            |c| {
+                c.collapsed_corners + c.dropped_repeated_index + c.dropped_zero_area + c.dropped_duplicates
+                    > 0
+            },
+        )?;
+    }
+    if params.non_manifold != NonManifoldMode::Keep {
+        if !r.dirty && input.non_manifold_edges == 0 && input.non_manifold_vertices == 0 {
+            r.skip("non_manifold", "input has no non-manifold edges or vertices");
+        } else {
+            r.step(
+                "non_manifold",
+                "non_manifold",
+                |m, p| nonmanifold::resolve(m, params.non_manifold, p),
+                |n| n.vertices_added + n.faces_removed > 0,
+            )?;
+        }
+    }
+    if params.orient {
+        if !r.dirty && input.inconsistent_orientation == 0 {
+            r.skip("orient", "input is consistently oriented");
+        } else {
+            r.step("orient", "orient", |m, _| Ok(orient::make_consistent(m)), |o| o.faces_flipped > 0)?;
+        }
+    }
+    if params.min_component_faces > 0 || params.keep_largest {
+        r.step(
+            "components",
+            "components",
+            |m, _| Ok(components::remove_small(m, params.min_component_faces, params.keep_largest)),
+            |c| c.faces_removed > 0,
+        )?;
+    }
+    Ok(())
+}
+
+/// Steps 6–8: fill holes, turn closed components outward, drop unreferenced vertices.
+fn close_and_compact(r: &mut Repairing, params: &RepairParams, input: &validate::Report) -> Result<()> {
+    if params.fill_holes {
+        if !r.dirty && input.boundary_edges == 0 {
+            r.skip("fill_holes", "input has no boundary");
+        } else {
+            let filled = r.step(
+                "fill_holes",
+                "fill_holes",
+                |m, p| holes::fill(m, &holes::FillOptions::from(params), p),
+                |h| h.filled > 0,
+            )?;
+            // A filled hole that touched a skipped one at a vertex leaves a closed fan next to an
+            // open one there (a non-manifold vertex the fill created): resolve those the same way.
+            if filled.filled > 0 && params.non_manifold != NonManifoldMode::Keep {
+                r.step(
+                    "non_manifold_after_fill",
+                    "non_manifold_after_fill",
+                    |m, p| nonmanifold::resolve(m, params.non_manifold, p),
+                    |_| false,
+                )?;
+            }
+            r.holes = Some(filled);
+        }
+    }
+    if params.orient && params.outward {
+        if !r.dirty && input.components == 1 && input.volume.is_some_and(|v| v > 0.0) {
+            r.skip("outward", "input is one closed component with positive volume");
+        } else {
+            r.step("outward", "outward", |m, _| Ok(orient::outward(m)), |o| o.components_flipped > 0)?;
+        }
+    }
+    if params.remove_unreferenced {
+        let c =
+            r.step("compact", "unreferenced", |m, _| Ok(clean::compact(m)), |c| c.removed_vertices > 0)?;
+        r.vmap.then(&c.map);
+    }
+    Ok(())
+}
+
+/// The job's report: input and output summaries, each step, why the output is not a closed
+/// manifold, where the vertices went (the whole map with `with_map`), and the timings.
+fn job_report(
+    r: &Repairing,
+    input: &validate::Report,
+    out: &validate::Report,
+    why: Vec<String>,
+    with_map: bool,
+) -> serde_json::Value {
+    let kept = r.vmap.map.iter().filter(|&&m| m != NONE).count();
     let mut report = serde_json::json!({
-        "input": summary(&input),
-        "output": summary(&out),
-        "steps": steps,
+        "input": summary(input),
+        "output": summary(out),
+        "steps": r.steps,
         "manifold": out.manifold && out.pinch_vertices == 0,
         "closed": out.closed,
         "why_not": why,
         "vertex_map": {
-            "input_vertices": vmap.map.len(),
+            "input_vertices": r.vmap.map.len(),
             "kept": kept,
-            "removed": vmap.map.len() - kept,
-            "output_vertices": mesh.positions.len(),
+            "removed": r.vmap.map.len() - kept,
+            "output_vertices": r.mesh.positions.len(),
         },
-        "stages": stages.to_json(),
-        "total_ms": stages.total_ms(),
+        "stages": r.stages.to_json(),
+        "total_ms": r.stages.total_ms(),
     });
-    if params.report_vertex_map {
-        report["vertex_map"]["map"] = serde_json::json!(vmap
+    if with_map {
+        report["vertex_map"]["map"] = serde_json::json!(r
+            .vmap
             .map
             .iter()
             .map(|&m| if m == NONE { -1 } else { m as i64 })
             .collect::<Vec<_>>());
     }
-    Ok(Output { meshes: vec![mesh], report, ..Default::default() })
+    report
 }
 
 /// Reasons the output is not a closed manifold, in words.

@@ -221,150 +221,215 @@ fn lines_json(model: &lines::Model) -> serde_json::Value {
 /// Runs the highlight fairing job.
 pub fn run(mesh: Mesh, p: &SmoothParams, progress: &Progress) -> Result<Output> {
     let r = p.resolve()?;
+    let w = Weights::of(p)?;
     let mut stages = Stages::new();
-    let epsilon = positive("convergence_threshold", p.convergence_threshold, DEFAULT_EPSILON)?;
-    let w_fair = positive("fairness_weight", p.fairness_weight, 1.0)?;
-    let w_diff = positive("highlight_weight", p.highlight_weight, 1.0)?;
-    let frac = positive("max_step_fraction", p.max_step_fraction, 0.5)?;
-    if frac > 0.5 {
-        return Err(Error::params("max_step_fraction", "at most 0.5 (the paper's bound, §3.6)"));
-    }
-    if w_fair == 0.0 && w_diff == 0.0 {
-        return Err(Error::params("fairness_weight", "fairness_weight and highlight_weight are both 0"));
-    }
-    let (adj, setup, defaults) = stages.run(progress, "prepare", || {
-        let adj = Adjacency::new(&mesh)?;
-        let region = region(&mesh, p)?;
-        let n = mesh.vertex_count();
-        let mut pinned = vec![false; n];
-        for &v in &p.pinned {
-            if v as usize >= n {
-                return Err(Error::params(
-                    "pinned",
-                    format!("vertex {v} out of range (mesh has {n} vertices)"),
-                ));
-            }
-            pinned[v as usize] = true;
-        }
-        let (lights, defaults) = lights(&mesh, &adj, &region, p)?;
-        let setup = fair::Setup::new(&adj, &mesh.positions, region, &pinned, lights, w_fair, w_diff, frac);
-        if setup.vars.len() > MAX_UNKNOWNS {
-            return Err(Error::TooLarge {
-                what: "highlight fairing: movable vertices (the method is local; select a smaller region)"
-                    .into(),
-                limit: MAX_UNKNOWNS as u64,
-                actual: setup.vars.len() as u64,
-            });
-        }
-        if setup.vars.is_empty() {
-            return Err(Error::params(
-                "region",
-                format!(
-                    "no movable vertex: a vertex moves only when it is at least 3 edges away from every \
-                     vertex outside R and from the mesh boundary (seed 001 §3.1); the region has {} \
-                     vertices — select a larger one",
-                    setup.region.iter().filter(|b| **b).count()
-                ),
-            ));
-        }
-        Ok((adj, setup, defaults))
-    })?;
+    let (adj, setup, defaults) = stages.run(progress, "prepare", || prepare(&mesh, p, &w))?;
     let x0 = &mesh.positions;
     let before = stages.run(progress, "model", || Ok(measure(&adj, x0, &setup)))?;
     let outcome = stages.run(progress, "fair", || {
-        fair::iterate(&adj, x0, &setup, r.iterations as usize, epsilon, progress)
+        fair::iterate(&adj, x0, &setup, r.iterations as usize, w.epsilon, progress)
     })?;
-    let x = &outcome.x;
-    let report = stages.run(progress, "metrics", || {
-        let after = measure(&adj, x, &setup);
-        let (max_d, _) = metrics::displacement(x0, x);
-        let moved: Vec<f64> =
-            (0..x.len()).filter(|&v| x[v] != x0[v]).map(|v| crate::geometry::dist(x[v], x0[v])).collect();
-        let mean_moved = if moved.is_empty() { 0.0 } else { moved.iter().sum::<f64>() / moved.len() as f64 };
-        let f = &mesh.faces;
-        let (a0, a1) = (metrics::angle_stats(x0, f), metrics::angle_stats(x, f));
-        let center = Aabb::of(x0).map(|b| b.center()).unwrap_or([0.0; 3]);
-        let (v0, v1) = (metrics::volume_about(x0, f, center), metrics::volume_about(x, f, center));
-        let hausdorff = r.hausdorff.then(|| crate::spatial::hausdorff_vertices(x0, f, x, f));
-        let mut warnings = Vec::new();
-        if before.runs.runs.is_empty() {
-            warnings.push(
-                "no highlight line crosses the movable part of the region: only the fairness term acts \
-                 (move or densify the lights: light_spacing, light_origin)"
-                    .to_string(),
-            );
-        }
-        if before.model.invalid_vertices > 0 {
-            warnings.push(format!(
-                "{} vertices have normals (nearly) parallel to the light plane: no highlight distance there",
-                before.model.invalid_vertices
-            ));
-        }
-        let mut rep = json!({
-            "method": "highlight",
-            "params": {
-                "iterations": r.iterations,
-                "convergence_threshold": epsilon,
-                "fairness_weight": w_fair,
-                "highlight_weight": w_diff,
-                "max_step_fraction": frac,
-            },
-            "lights": setup.lights,
-            "light_defaults_used": defaults,
-            "vertices": mesh.vertex_count(),
-            "faces": mesh.face_count(),
-            "region_vertices": setup.region.iter().filter(|b| **b).count(),
-            "movable_vertices": setup.vars.len(),
-            "energy_vertices": setup.energy_vertices.len(),
-            "vertices_moved": moved.len(),
-            "mean_edge_length_region": setup.e,
-            "iterations": outcome.steps.len(),
-            "stop_reason": outcome.stop_reason,
-            "history": outcome.steps,
-            "steps_halved_for_shape": outcome.flips_prevented,
-            "max_step_bound_use": outcome.max_bound_use,
-            "highlight_before": summary(&before),
-            "highlight_after": summary(&after),
-            "highlight_deviation_before": before.deviation,
-            "highlight_deviation_after": after.deviation,
-            "willmore_before": before.willmore,
-            "willmore_after": after.willmore,
-            "willmore_change": metrics::relative_change(before.willmore, after.willmore),
-            "mean_curvature_std_before": before.h_std,
-            "mean_curvature_std_after": after.h_std,
-            "max_displacement": max_d,
-            "max_displacement_relative": if setup.e > 0.0 { max_d / setup.e } else { 0.0 },
-            "mean_displacement_moved": mean_moved,
-            "volume_change": metrics::relative_change(v0, v1),
-            "area_change": metrics::relative_change(metrics::area(x0, f), metrics::area(x, f)),
-            "hausdorff": hausdorff,
-            "min_angle_before": a0.min,
-            "min_angle_after": a1.min,
-            "mean_min_angle_before": a0.mean_min,
-            "mean_min_angle_after": a1.mean_min,
-            "flipped_faces": metrics::flipped_faces(x0, x, f),
-            "solver": {
-                "kind": "box_qp_gradient_projection_cg",
-                "unknowns": outcome.qp_unknowns,
-                "nonzeros": outcome.qp_nonzeros,
-            },
-            "warnings": warnings,
-        });
-        if p.highlight_lines {
-            rep["highlight_lines"] =
-                json!({"before": lines_json(&before.model), "after": lines_json(&after.model)});
-        }
-        Ok(rep)
+    let mut report = stages.run(progress, "metrics", || {
+        let measured = Measured { mesh: &mesh, adj: &adj, setup: &setup, before: &before, outcome: &outcome };
+        Ok(job_report(&measured, p, &r, &w, defaults))
     })?;
-    let mut report = report;
     report["total_ms"] = json!(stages.total_ms());
     report["stages"] = stages.to_json();
     let mut out = mesh.clone();
     if out.normals.is_some() {
-        out.normals = Some(adj.normals(x));
+        out.normals = Some(adj.normals(&outcome.x));
     }
     out.positions = outcome.x;
     Ok(Output { meshes: vec![out], report, ..Default::default() })
+}
+
+/// The weights and bounds of Algorithm 2, checked.
+struct Weights {
+    /// Convergence threshold ε on the relative energy decrease.
+    epsilon: f64,
+    fair: f64,
+    highlight: f64,
+    /// Largest step as a fraction of the local edge length (≤ 0.5, §3.6).
+    max_step_fraction: f64,
+}
+
+impl Weights {
+    fn of(p: &SmoothParams) -> Result<Weights> {
+        let w = Weights {
+            epsilon: positive("convergence_threshold", p.convergence_threshold, DEFAULT_EPSILON)?,
+            fair: positive("fairness_weight", p.fairness_weight, 1.0)?,
+            highlight: positive("highlight_weight", p.highlight_weight, 1.0)?,
+            max_step_fraction: positive("max_step_fraction", p.max_step_fraction, 0.5)?,
+        };
+        if w.max_step_fraction > 0.5 {
+            return Err(Error::params("max_step_fraction", "at most 0.5 (the paper's bound, §3.6)"));
+        }
+        if w.fair == 0.0 && w.highlight == 0.0 {
+            return Err(Error::params("fairness_weight", "fairness_weight and highlight_weight are both 0"));
+        }
+        Ok(w)
+    }
+}
+
+/// Adjacency, region, pinned vertices and lights, and the setup of the optimisation; refuses a
+/// problem too large for this local method or with nothing allowed to move. Also returns which
+/// light settings were defaults.
+fn prepare(
+    mesh: &Mesh,
+    p: &SmoothParams,
+    w: &Weights,
+) -> Result<(Adjacency, fair::Setup, Vec<&'static str>)> {
+    let adj = Adjacency::new(mesh)?;
+    let region = region(mesh, p)?;
+    let pinned = pinned_mask(&p.pinned, mesh.vertex_count())?;
+    let (lights, defaults) = lights(mesh, &adj, &region, p)?;
+    let setup = fair::Setup::new(
+        &adj,
+        &mesh.positions,
+        region,
+        &pinned,
+        lights,
+        w.fair,
+        w.highlight,
+        w.max_step_fraction,
+    );
+    if setup.vars.len() > MAX_UNKNOWNS {
+        return Err(Error::TooLarge {
+            what: "highlight fairing: movable vertices (the method is local; select a smaller region)".into(),
+            limit: MAX_UNKNOWNS as u64,
+            actual: setup.vars.len() as u64,
+        });
+    }
+    if setup.vars.is_empty() {
+        return Err(Error::params(
+            "region",
+            format!(
+                "no movable vertex: a vertex moves only when it is at least 3 edges away from every \
+                 vertex outside R and from the mesh boundary (seed 001 §3.1); the region has {} \
+                 vertices — select a larger one",
+                setup.region.iter().filter(|b| **b).count()
+            ),
+        ));
+    }
+    Ok((adj, setup, defaults))
+}
+
+/// `pinned` as a per-vertex mask; an index past the mesh is a parameter error naming it.
+fn pinned_mask(pinned: &[u32], n: usize) -> Result<Vec<bool>> {
+    let mut mask = vec![false; n];
+    for &v in pinned {
+        if v as usize >= n {
+            return Err(Error::params("pinned", format!("vertex {v} out of range (mesh has {n} vertices)")));
+        }
+        mask[v as usize] = true;
+    }
+    Ok(mask)
+}
+
+/// What the report is made from.
+struct Measured<'a> {
+    mesh: &'a Mesh,
+    adj: &'a Adjacency,
+    setup: &'a fair::Setup,
+    before: &'a Measure,
+    outcome: &'a fair::Outcome,
+}
+
+/// The job's report: parameters, the highlight and fairness measures before and after, how far
+/// vertices moved, shape changes, the iteration history and warnings.
+fn job_report(
+    m: &Measured,
+    p: &SmoothParams,
+    r: &super::params::Resolved,
+    w: &Weights,
+    defaults: Vec<&'static str>,
+) -> serde_json::Value {
+    let (x0, x, f, setup, before) = (&m.mesh.positions, &m.outcome.x, &m.mesh.faces, m.setup, m.before);
+    let outcome = m.outcome;
+    let after = measure(m.adj, x, setup);
+    let (max_d, _) = metrics::displacement(x0, x);
+    let moved: Vec<f64> =
+        (0..x.len()).filter(|&v| x[v] != x0[v]).map(|v| crate::geometry::dist(x[v], x0[v])).collect();
+    let mean_moved = if moved.is_empty() { 0.0 } else { moved.iter().sum::<f64>() / moved.len() as f64 };
+    let (a0, a1) = (metrics::angle_stats(x0, f), metrics::angle_stats(x, f));
+    let center = Aabb::of(x0).map(|b| b.center()).unwrap_or([0.0; 3]);
+    let (v0, v1) = (metrics::volume_about(x0, f, center), metrics::volume_about(x, f, center));
+    let hausdorff = r.hausdorff.then(|| crate::spatial::hausdorff_vertices(x0, f, x, f));
+    let mut rep = json!({
+        "method": "highlight",
+        "params": {
+            "iterations": r.iterations,
+            "convergence_threshold": w.epsilon,
+            "fairness_weight": w.fair,
+            "highlight_weight": w.highlight,
+            "max_step_fraction": w.max_step_fraction,
+        },
+        "lights": setup.lights,
+        "light_defaults_used": defaults,
+        "vertices": m.mesh.vertex_count(),
+        "faces": m.mesh.face_count(),
+        "region_vertices": setup.region.iter().filter(|b| **b).count(),
+        "movable_vertices": setup.vars.len(),
+        "energy_vertices": setup.energy_vertices.len(),
+        "vertices_moved": moved.len(),
+        "mean_edge_length_region": setup.e,
+        "iterations": outcome.steps.len(),
+        "stop_reason": outcome.stop_reason,
+        "history": outcome.steps,
+        "steps_halved_for_shape": outcome.flips_prevented,
+        "max_step_bound_use": outcome.max_bound_use,
+        "highlight_before": summary(before),
+        "highlight_after": summary(&after),
+        "highlight_deviation_before": before.deviation,
+        "highlight_deviation_after": after.deviation,
+        "willmore_before": before.willmore,
+        "willmore_after": after.willmore,
+        "willmore_change": metrics::relative_change(before.willmore, after.willmore),
+        "mean_curvature_std_before": before.h_std,
+        "mean_curvature_std_after": after.h_std,
+        "max_displacement": max_d,
+        "max_displacement_relative": if setup.e > 0.0 { max_d / setup.e } else { 0.0 },
+        "mean_displacement_moved": mean_moved,
+        "volume_change": metrics::relative_change(v0, v1),
+        "area_change": metrics::relative_change(metrics::area(x0, f), metrics::area(x, f)),
+        "hausdorff": hausdorff,
+        "min_angle_before": a0.min,
+        "min_angle_after": a1.min,
+        "mean_min_angle_before": a0.mean_min,
+        "mean_min_angle_after": a1.mean_min,
+        "flipped_faces": metrics::flipped_faces(x0, x, f),
+        "solver": {
+            "kind": "box_qp_gradient_projection_cg",
+            "unknowns": outcome.qp_unknowns,
+            "nonzeros": outcome.qp_nonzeros,
+        },
+        "warnings": warnings(before),
+    });
+    if p.highlight_lines {
+        rep["highlight_lines"] =
+            json!({"before": lines_json(&before.model), "after": lines_json(&after.model)});
+    }
+    rep
+}
+
+/// What the user should know about the start state: no highlight line to fair, or vertices the
+/// lights cannot measure.
+fn warnings(before: &Measure) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if before.runs.runs.is_empty() {
+        warnings.push(
+            "no highlight line crosses the movable part of the region: only the fairness term acts \
+             (move or densify the lights: light_spacing, light_origin)"
+                .to_string(),
+        );
+    }
+    if before.model.invalid_vertices > 0 {
+        warnings.push(format!(
+            "{} vertices have normals (nearly) parallel to the light plane: no highlight distance there",
+            before.model.invalid_vertices
+        ));
+    }
+    warnings
 }
 
 /// Highlight model and energies of one state.
