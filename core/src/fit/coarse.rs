@@ -80,7 +80,7 @@ pub(super) fn coarse_alignment(
         _ => false,
     };
     if use_pairs {
-        let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net)?;
+        let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net, params.max_curve_distance)?;
         if params.coplanar_centres == CoplanarCentres::Augment && pairs_on_a_line(pos, &fixed, net) {
             return pairs_similarity(pos, tris, net, &fixed, snap_max, progress);
         }
@@ -300,9 +300,17 @@ fn pairs_similarity(
     })
 }
 
-/// Validates the pairs and snaps each curve point to its nearest curve vertex.
-fn snap_pairs(pairs: &[FitPair], nv: usize, net: &curves::CurveNetwork) -> Result<(Vec<(u32, u32)>, f64)> {
+/// Validates the pairs and snaps each curve point to its nearest curve vertex. A point farther
+/// than `max_distance` × the curves' bounding-box diagonal from every curve vertex is an error (a
+/// typo or a point in other units would otherwise pull the template onto the wrong vertex).
+fn snap_pairs(
+    pairs: &[FitPair],
+    nv: usize,
+    net: &curves::CurveNetwork,
+    max_distance: f64,
+) -> Result<(Vec<(u32, u32)>, f64)> {
     let tree = kdtree::KdTree::new(&net.points);
+    let limit = max_distance * Aabb::of(&net.points).map_or(0.0, |b| b.diagonal());
     let mut out: Vec<(u32, u32)> = Vec::with_capacity(pairs.len());
     let mut snap_max = 0.0f64;
     for (i, p) in pairs.iter().enumerate() {
@@ -318,6 +326,19 @@ fn snap_pairs(pairs: &[FitPair], nv: usize, net: &curves::CurveNetwork) -> Resul
         let (cp, d2) =
             tree.nearest(p.curve_point).ok_or_else(|| Error::Internal("empty curve network".into()))?;
         snap_max = snap_max.max(d2.sqrt());
+        if d2.sqrt() > limit {
+            return Err(Error::params(
+                format!("pairs[{i}].curve_point"),
+                format!(
+                    "{:?} is {:.4} from the nearest curve vertex {:?}, more than max_curve_distance ({}) \
+                     × the curves' bounding-box diagonal ({limit:.4} in all): give a point on the curves",
+                    p.curve_point,
+                    d2.sqrt(),
+                    net.points[cp as usize],
+                    max_distance
+                ),
+            ));
+        }
         if let Some(j) = out.iter().position(|&(_, v)| v == p.template_vertex) {
             return Err(Error::params(
                 format!("pairs[{i}].template_vertex"),

@@ -36,6 +36,7 @@ pub mod rbf;
 pub mod report;
 pub mod retriangulate;
 pub mod smooth;
+pub mod template;
 pub mod testdata;
 pub mod trimesh;
 pub mod untangle;
@@ -61,6 +62,16 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut it = inputs.into_iter();
     let (Some(template), Some(curve_mesh), None) = (it.next(), it.next(), it.next()) else {
         return Err(Error::params("inputs", "fit takes exactly two meshes: template, curves"));
+    };
+    // Vertices in no face are removed first (counted in the report); pairs are renumbered.
+    let (template, renumbered_pairs, unreferenced) = template::drop_unreferenced(template, &params.pairs)?;
+    let renumbered;
+    let params = match renumbered_pairs {
+        Some(pairs) => {
+            renumbered = FitParams { pairs, ..params.clone() };
+            &renumbered
+        }
+        None => params,
     };
     let mut stages = Stages::new();
     let net = stages.run(progress, "curves", || {
@@ -350,9 +361,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     moved_vertices.sort_unstable();
     moved_vertices.dedup();
     let report = serde_json::json!({
-        "template_vertices": template.vertex_count(),
+        "template_vertices": template.vertex_count() + unreferenced,
         "template_faces": template.face_count(),
         "template_triangles": crate::shapes::fan_triangles(&template.faces).len(),
+        "template_unreferenced_vertices_removed": unreferenced,
         "template_groups_kept": if keep_groups { template.groups.len() } else { 0 },
         "output_vertices": out.vertex_count(),
         "output_faces": out.face_count(),

@@ -1,0 +1,109 @@
+//! The rest of a segment after a failed walk, from wherever the walk stopped: the seed's
+//! Dijkstra-and-project (§3.2) when it turns no face over, else the route across faces made a
+//! chain by edge splits ([`super::route`]); a segment with neither is recorded as failed.
+
+use crate::mesh::Point3;
+
+use super::super::trimesh::IntMap;
+use super::dijkstra::{dijkstra_project, Projected};
+use super::snap::{closest_on_segment, keeps_orientation};
+use super::split::split_crossings;
+use super::stats::{detour, FailedSegment, Fallback};
+use super::{lock_chain, route, Work};
+
+/// Largest number of faces the route fallback settles for one segment.
+const ROUTE_BUDGET: usize = 1_000_000;
+
+impl Work<'_> {
+    /// Completes segment `si` (curve points `seg`, mesh vertices `(u, w)`) whose walk stopped
+    /// for `walk`; `chain` holds what the walk made. Records the method, or the failure.
+    pub(super) fn finish_segment(
+        &mut self,
+        si: usize,
+        seg: [u32; 2],
+        (u, w): (u32, u32),
+        walk: &'static str,
+        chain: &mut Vec<u32>,
+    ) {
+        let from = *chain.last().unwrap_or(&u);
+        let seg_ends = (self.mesh.pos[u as usize], self.mesh.pos[w as usize]);
+        let n0 = chain.len();
+        match self.fallback(from, w, seg_ends, chain) {
+            Ok(m) => {
+                let d = detour(self.mesh, &chain[n0 - 1..]);
+                self.stats.record_fallback(si, m, d);
+                lock_chain(&mut self.locked, &chain[n0 - 1..]);
+            }
+            Err(why) => {
+                if self.stats.failed.len() < 20 {
+                    self.stats.failed.push(FailedSegment {
+                        segment: si,
+                        points: seg,
+                        vertices: [u, w],
+                        stopped_at: from,
+                        walk,
+                        route: match why {
+                            route::NoRoute::Separated => "separated",
+                            route::NoRoute::Budget => "budget",
+                        },
+                    });
+                }
+                self.stats.failed_segments += 1;
+                chain.push(w);
+            }
+        }
+    }
+
+    /// Realises the rest of a segment from `from` (the last chain vertex) to `to`. Pushes the
+    /// chain after `from` including `to`.
+    fn fallback(
+        &mut self,
+        from: u32,
+        to: u32,
+        seg: (Point3, Point3),
+        chain: &mut Vec<u32>,
+    ) -> Result<Fallback, route::NoRoute> {
+        match dijkstra_project(self.mesh, from, to, &self.on_curve, &mut self.uv_moves) {
+            Projected::Done(path) => {
+                for &v in &path[1..] {
+                    self.on_curve[v as usize] = true;
+                    chain.push(v);
+                }
+                return Ok(Fallback::Dijkstra(path.len().saturating_sub(2)));
+            }
+            Projected::WouldFlip => self.stats.fallback_refused_flips += 1,
+            Projected::NoPath => {}
+        }
+        let crossings = route::find(self.mesh, from, to, seg, &self.locked, ROUTE_BUDGET)?;
+        let n0 = chain.len();
+        if !split_crossings(self.mesh, &crossings, &mut self.on_curve, &mut self.added, chain) {
+            // Cannot happen for a route of distinct faces (each split leaves the next edge in
+            // place); kept as a named failure rather than a panic.
+            return Err(route::NoRoute::Budget);
+        }
+        let new: Vec<u32> = chain[n0..].to_vec();
+        self.pull_onto_segment(&new, seg);
+        chain.push(to);
+        Ok(Fallback::Route(new.len()))
+    }
+
+    /// The split points lie on the surface; each moves onto the straight segment where that turns
+    /// no face of its star over (against the normals before any move).
+    fn pull_onto_segment(&mut self, new: &[u32], seg: (Point3, Point3)) {
+        let mesh = &mut *self.mesh;
+        let mut before: IntMap<u32, Point3> = IntMap::default();
+        for &m in new {
+            for &f in mesh.faces_of(m) {
+                before.insert(f, mesh.face_normal(f));
+            }
+        }
+        for &m in new {
+            let target = closest_on_segment(mesh.pos[m as usize], seg.0, seg.1);
+            if keeps_orientation(mesh, m, target, |f| before.get(&f).copied()) {
+                self.uv_moves.extend(super::super::uvs::record(mesh, m, target));
+                mesh.pos[m as usize] = target;
+                self.stats.route_vertices_on_segment += 1;
+            }
+        }
+    }
+}
