@@ -52,14 +52,44 @@ fn check_distances(
     template_diag: f64,
 ) -> Result<()> {
     let limit = params.max_curve_distance * template_diag;
-    if let Some((p, d)) = distances.iter().enumerate().find(|(_, &d)| d > limit) {
+    // The farthest point names the curve: with an automatic alignment one stray curve drags the
+    // template towards it, and the first point over the limit is then on a good curve.
+    let far = distances.iter().enumerate().filter(|(_, &d)| d > limit).max_by(|a, b| a.1.total_cmp(b.1));
+    if let Some((p, &d)) = far {
         let c = net.curve_of_point[p];
+        let mut curves: Vec<u32> = distances
+            .iter()
+            .enumerate()
+            .filter(|(_, &d)| d > limit)
+            .map(|(q, _)| net.curve_of_point[q])
+            .collect();
+        curves.sort_unstable();
+        curves.dedup();
+        // A part of the network far from the rest is the likely cause: name it first.
+        let stray = net.stray_parts();
+        if let Some((sc, gap, size)) = stray.first() {
+            return Err(Error::params(
+                "curves",
+                format!(
+                    "curve {} is {gap:.4} away from the rest of the network, farther than the rest's \
+                     size ({size:.4}), and the curves do not fit the template (point {:?} of curve {c} is \
+                     {d:.4} from it after alignment, more than max_curve_distance ({}) × the template's \
+                     bounding-box diagonal): a stray curve? (curves of that part: {sc:?})",
+                    sc[0], net.points[p], params.max_curve_distance
+                ),
+            ));
+        }
+        let others = if curves.len() > 1 {
+            format!(" ({} curves have points that far: {curves:?})", curves.len())
+        } else {
+            String::new()
+        };
         return Err(Error::params(
             "curves",
             format!(
                 "curve {c}: its point {:?} is {d:.4} from the template, more than \
                  max_curve_distance ({}) × the template's bounding-box diagonal ({template_diag:.4}) \
-                 after alignment; the curves do not lie on the template (check units, or give pairs)",
+                 after alignment{others}; the curves do not lie on the template (check units, or give pairs)",
                 net.points[p], params.max_curve_distance
             ),
         ));

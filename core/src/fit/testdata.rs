@@ -3,9 +3,9 @@
 
 use std::collections::HashMap;
 
-use crate::geometry::{add, dot, scale, sub, Aabb};
-use crate::mesh::{Mesh, Point3};
-use crate::shapes::{fan_triangles, subdivide_midpoint};
+use crate::geometry::{add, dot, norm, scale, sub, Aabb};
+use crate::mesh::{Faces, Mesh, Point3};
+use crate::shapes::{fan_triangles, icosphere, subdivide_midpoint};
 
 /// The three principal-plane sections of the ellipsoid x²/a² + y²/b² + z²/c² = 1, each sampled at
 /// `per_quadrant` points per quarter so that the six axis points are shared: 6 feature points of
@@ -457,4 +457,180 @@ pub fn sweep_planes(m: &Mesh) -> Vec<(Point3, f64)> {
         p.push((axis(k), bb.min[k] + 0.4987 * ext[k]));
     }
     p
+}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs nobody tried before (the `sweep_unseen` example and `tests/fit_unseen*.rs`): templates
+// with n-gons, holes, several components or a zero-area face, and curve files written the way
+// other programs write them (glTF LINES / LINE_LOOP, OBJ negative indices, ends that miss).
+
+/// A closed UV sphere of radius `r` with `nu` segments and `nv` rings whose poles are single
+/// `nu`-gons (cut at latitude ±(90° − 90°/nv)) and whose sides are quads: an n-gon template.
+pub fn ngon_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
+    let mut pos = Vec::new();
+    for j in 0..nv {
+        let lat = -std::f64::consts::PI / 2.0 + std::f64::consts::PI * (j as f64 + 0.5) / nv as f64;
+        for i in 0..nu {
+            let t = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
+            pos.push([r * lat.cos() * t.cos(), r * lat.cos() * t.sin(), r * lat.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * nu + i % nu) as u32;
+    let mut faces = Faces::new();
+    let bottom: Vec<u32> = (0..nu).rev().map(|i| id(i, 0)).collect();
+    faces.push(&bottom, 0);
+    for j in 0..nv - 1 {
+        for i in 0..nu {
+            faces.push(&[id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)], 0);
+        }
+    }
+    let top: Vec<u32> = (0..nu).map(|i| id(i, nv - 1)).collect();
+    faces.push(&top, 0);
+    Mesh::new(pos, faces)
+}
+
+/// `m` without the faces whose centroid is within `radius` of one of `centres`.
+pub fn with_holes(m: &Mesh, centres: &[Point3], radius: f64) -> Mesh {
+    let mut out = m.clone();
+    let pos = m.positions.clone();
+    let faces = m.faces.clone();
+    out.faces.retain(|i| {
+        let f = faces.get(i);
+        let c = f.iter().fold([0.0; 3], |a, &v| {
+            let p = pos[v as usize];
+            [a[0] + p[0], a[1] + p[1], a[2] + p[2]]
+        });
+        let c = [c[0] / f.len() as f64, c[1] / f.len() as f64, c[2] / f.len() as f64];
+        centres.iter().all(|&q| norm(sub(c, q)) > radius)
+    });
+    out
+}
+
+/// Two meshes as one (the second's indices shifted).
+pub fn disjoint_union(a: &Mesh, b: &Mesh) -> Mesh {
+    let mut pos = a.positions.clone();
+    pos.extend_from_slice(&b.positions);
+    let n = a.positions.len() as u32;
+    let mut faces = a.faces.clone();
+    for f in b.faces.iter() {
+        let g: Vec<u32> = f.iter().map(|&v| v + n).collect();
+        faces.push(&g, 0);
+    }
+    Mesh::new(pos, faces)
+}
+
+/// The icosphere with one edge split by a vertex on it and a zero-area face filling the split
+/// on one side, plus an unreferenced duplicate of vertex 0: closed, manifold, consistently
+/// oriented, but with a degenerate face.
+pub fn with_zero_area_face(levels: u32) -> Mesh {
+    let m = icosphere(levels, 1.0);
+    let tris = m.faces.triangles();
+    let (a, b, c) = (tris[0][0], tris[0][1], tris[0][2]);
+    // The face across a-b (holding b→a) is untouched: the new face (mid, a, b) takes its place
+    // along that edge, and (a, mid, c), (mid, b, c) replace face 0.
+    let mut pos = m.positions.clone();
+    let pa = pos[a as usize];
+    let pb = pos[b as usize];
+    pos.push([(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0, (pa[2] + pb[2]) / 2.0]);
+    let mid = (pos.len() - 1) as u32;
+    pos.push(pos[0]);
+    let mut out = vec![[a, mid, c], [mid, b, c], [mid, a, b]];
+    out.extend_from_slice(&tris[1..]);
+    Mesh::from_triangles(pos, &out)
+}
+
+/// A glTF (JSON with an embedded base64 buffer) holding `points` and one primitive of `mode` with
+/// `indices`.
+pub fn gltf_lines(points: &[Point3], indices: &[u32], mode: u32) -> Vec<u8> {
+    let mut buf = Vec::new();
+    for p in points {
+        for &x in p {
+            buf.extend_from_slice(&(x as f32).to_le_bytes());
+        }
+    }
+    let pos_len = buf.len();
+    for &i in indices {
+        buf.extend_from_slice(&i.to_le_bytes());
+    }
+    let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] as f32);
+            hi[k] = hi[k].max(p[k] as f32);
+        }
+    }
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": buf.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&buf))}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": pos_len},
+            {"buffer": 0, "byteOffset": pos_len, "byteLength": buf.len() - pos_len}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": points.len(), "type": "VEC3", "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": mode}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    serde_json::to_vec(&doc).unwrap_or_default()
+}
+
+pub fn base64(b: &[u8]) -> String {
+    const T: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in b.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+/// `curves` (e.g. the ellipsoid sections) as OBJ text with negative (relative) indices.
+pub fn obj_negative_indices(curves: &Mesh) -> Vec<u8> {
+    let mut s = String::new();
+    for c in &curves.curves {
+        for &v in c {
+            let p = curves.positions[v as usize];
+            s += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        s += "l";
+        for k in 0..c.len() {
+            s += &format!(" {}", k as i64 - c.len() as i64);
+        }
+        s += "\n";
+    }
+    s.into_bytes()
+}
+
+/// The principal sections of the ellipsoid with semi-axes `axes` as 12 separate quarter arcs (6 segments each) whose shared ends are moved apart by `gap`
+/// (absolute), so joining them is left to the network's tolerances.
+pub fn quarter_arcs_with_gap(axes: [f64; 3], gap: f64) -> Mesh {
+    let mut lines = Vec::new();
+    for (i, j) in [(0usize, 1usize), (1, 2), (2, 0)] {
+        for q in 0..4 {
+            let mut line = Vec::new();
+            for k in 0..=6 {
+                let t = (q as f64 + k as f64 / 6.0) * std::f64::consts::PI / 2.0;
+                let mut p = [0.0; 3];
+                p[i] = axes[i] * t.cos();
+                p[j] = axes[j] * t.sin();
+                line.push(p);
+            }
+            // Each arc's start is pushed along the third axis by ±gap/2.
+            let third = 3 - i - j;
+            let s = if q % 2 == 0 { 0.5 } else { -0.5 };
+            line[0][third] += s * gap;
+            lines.push(line);
+        }
+    }
+    polylines(&lines)
 }

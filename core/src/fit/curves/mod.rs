@@ -195,6 +195,60 @@ impl CurveNetwork {
         self.degree.iter().filter(|&&d| d > 2).count()
     }
 
+    /// Parts of the network (connected through segments) smaller than the others together and
+    /// farther from them than the others' bounding-box diagonal: (input curves of the part, gap,
+    /// the others' diagonal).
+    /// Used to name a stray curve when the curves do not fit the template: an automatic
+    /// alignment stretches the template between the stray part and the rest, so the curves it
+    /// then finds far are the good ones.
+    pub fn stray_parts(&self) -> Vec<(Vec<u32>, f64, f64)> {
+        let n = self.points.len();
+        let mut parent: Vec<usize> = (0..n).collect();
+        fn root(p: &mut [usize], mut i: usize) -> usize {
+            while p[i] != i {
+                p[i] = p[p[i]];
+                i = p[i];
+            }
+            i
+        }
+        for s in &self.segments {
+            let (a, b) = (root(&mut parent, s[0] as usize), root(&mut parent, s[1] as usize));
+            parent[a] = b;
+        }
+        let part: Vec<usize> = (0..n).map(|i| root(&mut parent, i)).collect();
+        let mut roots: Vec<usize> = part.clone();
+        roots.sort_unstable();
+        roots.dedup();
+        if roots.len() < 2 {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        for &r in &roots {
+            let (inside, others): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| part[i] == r);
+            let pts = |ids: &[usize]| ids.iter().map(|&i| self.points[i]).collect::<Vec<_>>();
+            let Some(rest) = Aabb::of(&pts(&others)) else { continue };
+            // Distance of each point of the part to the others' box; the part's nearest point counts.
+            let gap = inside
+                .iter()
+                .map(|&i| {
+                    let p = self.points[i];
+                    let d: Vec<f64> =
+                        (0..3).map(|k| (rest.min[k] - p[k]).max(p[k] - rest.max[k]).max(0.0)).collect();
+                    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+                })
+                .fold(f64::INFINITY, f64::min);
+            let own = Aabb::of(&pts(&inside)).map_or(0.0, |b| b.diagonal());
+            // The smaller of two far-apart parts is the stray one.
+            if gap > rest.diagonal() && own < rest.diagonal() {
+                let mut curves: Vec<u32> = inside.iter().map(|&i| self.curve_of_point[i]).collect();
+                curves.sort_unstable();
+                curves.dedup();
+                out.push((curves, gap, rest.diagonal()));
+            }
+        }
+        out
+    }
+
     /// Shortest segment length (0 when there is none).
     pub fn min_segment(&self) -> f64 {
         self.segments
