@@ -134,13 +134,14 @@ fn main() {
     faer::set_global_parallelism(faer::Par::Seq);
     let only: Vec<String> = std::env::args().skip(1).collect();
     println!(
-        "{:<16} {:<6} {:>6} {:>6} {:>7} {:>6} {:>8} {:>9} {:>6} {:>9} {:>9} {:>8}",
+        "{:<16} {:<6} {:>6} {:>6} {:>7} {:>6} {:>6} {:>8} {:>9} {:>6} {:>9} {:>9} {:>8}",
         "mesh",
         "align",
         "tmplV",
         "curveV",
         "time s",
         "flips",
+        "folds",
         "edges %",
         "regions",
         "euler",
@@ -190,11 +191,13 @@ fn main() {
                         );
                     }
                     println!(
-                        "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>8.2} {:>4}/{:<4} {:>6} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
+                        "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>6} {:>8.2} {:>4}/{:<4} {:>6} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
                         template.positions.len(),
                         curves.positions.len(),
                         secs,
                         format!("{}/{}", r["flipped_faces_before_smoothing"], r["flipped_faces"]),
+                        // Reference-free folded edges (output; the template's own in brackets).
+                        format!("{}({})", r["folded_edges"], r["folds"]["template"]["folded_edges"]),
                         100.0 * r["segments_as_edges"].as_f64().unwrap_or(f64::NAN),
                         r["regions"],
                         expected,

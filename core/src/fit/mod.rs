@@ -249,6 +249,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     };
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
     let flipped_before_smoothing = untangle::count_flipped(&mesh.pos, &out_tris, &reference_normals);
+    let folds_before_smoothing = untangle::fold_stats(&mesh.pos, &out_tris);
     let mut out_pos = mesh.pos.clone();
     let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
@@ -362,6 +363,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &reference_normals,
         ))
     })?;
+    let folds = untangle::fold_stats(&out.positions, &out_tris);
+    let fold_report = serde_json::json!({
+        "fold_angle_deg": untangle::FOLD_ANGLE_DEG,
+        "output": folds,
+        "before_smoothing": folds_before_smoothing,
+        "template": untangle::fold_stats(&template.positions, &crate::shapes::fan_triangles(&template.faces)),
+    });
     // Every vertex moved over the surface (its UV re-read where it landed), in the numbering
     // before the clean-up: re-triangulation snaps, untangling, smoothing.
     let mut moved_vertices: Vec<u32> = realised.uv_moves.iter().map(|m| m.vertex).collect();
@@ -371,7 +379,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     moved_vertices.extend_from_slice(&smooth_moved);
     moved_vertices.sort_unstable();
     moved_vertices.dedup();
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "template_vertices": template.vertex_count() + unreferenced,
         "template_faces": template.face_count(),
         "template_triangles": crate::shapes::fan_triangles(&template.faces).len(),
@@ -414,6 +422,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "total_ms": stages.total_ms(),
         "stages": stages.to_json(),
     });
+    // Reference-free: adjacent faces folded back onto each other (untangle::fold_stats). Added
+    // after the literal, which is at serde_json's macro recursion limit.
+    report["folded_edges"] = folds.folded_edges.into();
+    report["folds"] = fold_report;
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }
 

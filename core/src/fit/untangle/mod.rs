@@ -24,7 +24,10 @@ use super::trimesh::{IntHasher, TriMesh};
 use super::uvs::{self, UvMove};
 
 mod energy;
+mod folds;
 mod patch;
+
+pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
 
 /// A face counts as folded when its normal is within this cosine of perpendicular to the reference
 /// (or beyond): a face standing on its edge, e.g. three consecutive vertices of one planar curve,
