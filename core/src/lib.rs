@@ -8,6 +8,7 @@
 pub mod error;
 pub mod fit;
 pub mod geometry;
+pub mod hash;
 pub mod io;
 pub mod job;
 pub mod laplacian;

@@ -135,31 +135,8 @@ pub fn analyze_staged(
 
     let topo = stages.run(progress, "topology", || Ok(Topology::new(mesh)))?;
 
-    // Faces: arity, out-of-range, degenerate, area, duplicates.
-    let (face_arity, out_of_range, degenerate, area, duplicates) = stages.run(progress, "faces", || {
-        let mut arity = std::collections::BTreeMap::new();
-        let mut out_of_range = 0;
-        let mut degenerate = Vec::new();
-        let mut area = 0.0;
-        let zero = ZERO_AREA_REL * diag * diag;
-        for (fi, f) in faces.iter().enumerate() {
-            *arity.entry(f.len().to_string()).or_insert(0) += 1;
-            if f.iter().any(|&v| v as usize >= n) {
-                out_of_range += 1;
-                continue;
-            }
-            let a = polygon_area(&mesh.positions, f);
-            area += a;
-            if distinct_count(f) < 3 || !(a > zero) {
-                degenerate.push(fi);
-            }
-            if fi % 65536 == 0 {
-                progress.check()?;
-            }
-        }
-        let duplicates = duplicate_faces(faces);
-        Ok((arity, out_of_range, degenerate, area, duplicates))
-    })?;
+    let FaceScan { arity: face_arity, out_of_range, degenerate, area, duplicates } =
+        stages.run(progress, "faces", || scan_faces(mesh, diag, progress))?;
     ex.degenerate_faces = degenerate.iter().take(max_examples).copied().collect();
     ex.duplicate_faces = duplicates.iter().take(max_examples).copied().collect();
 
@@ -236,6 +213,49 @@ pub fn analyze_staged(
         volume,
         examples: ex,
     })
+}
+
+/// What one pass over the faces finds.
+struct FaceScan {
+    /// Face count per arity ("3", "4", …).
+    arity: std::collections::BTreeMap<String, usize>,
+    /// Faces with an index past the vertex list (skipped by everything else here).
+    out_of_range: usize,
+    /// Faces with fewer than three distinct corners or (near) zero area.
+    degenerate: Vec<usize>,
+    area: f64,
+    duplicates: Vec<usize>,
+}
+
+/// Arity, out-of-range indices, degenerate faces (area below [`ZERO_AREA_REL`] of the squared
+/// bounding-box diagonal `diag`), total area and duplicate faces.
+fn scan_faces(mesh: &Mesh, diag: f64, progress: &Progress) -> Result<FaceScan> {
+    let n = mesh.positions.len();
+    let mut scan = FaceScan {
+        arity: Default::default(),
+        out_of_range: 0,
+        degenerate: Vec::new(),
+        area: 0.0,
+        duplicates: Vec::new(),
+    };
+    let zero = ZERO_AREA_REL * diag * diag;
+    for (fi, f) in mesh.faces.iter().enumerate() {
+        *scan.arity.entry(f.len().to_string()).or_insert(0) += 1;
+        if f.iter().any(|&v| v as usize >= n) {
+            scan.out_of_range += 1;
+            continue;
+        }
+        let a = polygon_area(&mesh.positions, f);
+        scan.area += a;
+        if distinct_count(f) < 3 || !(a > zero) {
+            scan.degenerate.push(fi);
+        }
+        if fi % 65536 == 0 {
+            progress.check()?;
+        }
+    }
+    scan.duplicates = duplicate_faces(&mesh.faces);
+    Ok(scan)
 }
 
 /// Area of a polygon from its vector area (Newell), exact for planar polygons of any arity.

@@ -113,3 +113,79 @@ fn pairs_on_one_line_of_a_flat_template_fall_back_to_a_similarity() {
     let dev = Bvh::new(&truth.positions, &truth.faces).max_distance(&out.meshes[0].positions) / diag;
     assert!(dev < 0.05, "output within 5% of the diagonal of the bent template: {dev}");
 }
+
+/// An ellipsoid with three different axes is symmetric under the half turns about its axes, and
+/// its principal sections are too: the automatic alignment cannot tell those poses apart (truth:
+/// the symmetry, known analytically), so it must say so rather than pick one silently.
+#[test]
+fn a_symmetric_template_is_reported_as_ambiguous() {
+    use meshwork_core::fit::testdata::ellipsoid_sections;
+    let axes = [1.0, 0.6, 0.35];
+    let mut template = meshwork_core::shapes::icosphere(3, 1.0);
+    for p in &mut template.positions {
+        for k in 0..3 {
+            p[k] *= axes[k];
+        }
+    }
+    let out = run(vec![template, ellipsoid_sections(axes, 12)], &FitParams::default(), &Progress::new())
+        .expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("alignment {a}");
+    assert_eq!(a["method"], "pca_icp");
+    assert_eq!(a["ambiguous"], true, "{a}");
+    assert!(a["warning"].as_str().is_some_and(|w| w.contains("pairs")), "{a}");
+    // The runner-up is a genuinely different pose (a half turn), not the same one found twice.
+    let angle = a["candidates"][1]["angle_deg"].as_f64().unwrap();
+    assert!(angle > 90.0, "runner-up {angle}°");
+}
+
+/// A known similarity (rotation of 70° about (1, 2, 3), scale 2.5, a translation) applied to the
+/// plane sections of an asymmetric shape (spot): PCA + ICP must recover it (truth: the map that
+/// was applied), and the fit must not call the result ambiguous.
+#[test]
+fn a_known_rotation_scale_and_translation_is_recovered() {
+    let m = shared("spot");
+    let mut curves = thin_network(&plane_sections(&m, &sweep_planes(&m)), 2);
+    let axis = {
+        let n = (1.0f64 + 4.0 + 9.0).sqrt();
+        [1.0 / n, 2.0 / n, 3.0 / n]
+    };
+    let (s, c) = 70f64.to_radians().sin_cos();
+    let [x, y, z] = axis;
+    let t = 1.0 - c;
+    let r = [
+        [c + x * x * t, x * y * t - z * s, x * z * t + y * s],
+        [y * x * t + z * s, c + y * y * t, y * z * t - x * s],
+        [z * x * t - y * s, z * y * t + x * s, c + z * z * t],
+    ];
+    let truth = align::Similarity { r, s: 2.5, t: [3.0, -1.0, 2.0] };
+    for p in &mut curves.positions {
+        *p = truth.apply(*p);
+    }
+    let net = CurveNetwork::from_mesh(&curves, 1e-6).unwrap();
+    let (sim, _) = align::pca_icp(&m.positions, &net.points, 30, &Progress::new()).unwrap();
+    let angle = align::rotation_angle_deg(&sim.r, &truth.r);
+    eprintln!("rotation error {angle:.3}°, scale {:.4} (truth 2.5), translation {:?}", sim.s, sim.t);
+    assert!(angle < 2.0, "rotation recovered within 2°: {angle}");
+    assert!((sim.s / 2.5 - 1.0).abs() < 0.02, "scale within 2%: {}", sim.s);
+    assert!(dist(sim.t, truth.t) < 0.05 * 2.5, "translation within 5% of the size: {:?}", sim.t);
+    let template = subdivide_midpoint(&m, 1);
+    let out = run(vec![template, curves], &FitParams::default(), &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    assert_eq!(a["ambiguous"], false, "{a}");
+    assert_eq!(out.report["segments_as_edges"].as_f64(), Some(1.0));
+}
+
+/// Woody is flat and nearly symmetric: turned over, it fits its sections almost as well, and
+/// the fit must say so (before: it silently chose the mirror image, 5 of 11 regions).
+#[test]
+fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
+    let m = shared("woody");
+    let template = subdivide_midpoint(&m, 1);
+    let params =
+        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
+    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("alignment {a}");
+    assert_eq!(a["ambiguous"], true, "{a}");
+}

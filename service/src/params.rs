@@ -20,12 +20,18 @@ pub fn snake(name: &str) -> String {
 /// `known_with_value` are long/short options clap parses that take a value (`-o`, `--format`,
 /// …); `known_switches` take none (`--quiet`, `--help`). Everything else spelled `--name` is a
 /// parameter: `--name=VALUE`, `--name VALUE`, or `--name` alone (= `true`) when it is last or
-/// followed by another `--option`. Positional arguments pass through to clap.
+/// followed by another `--option` or by one of clap's short options (`-o`, `-q`). Positional arguments pass through to clap.
 pub fn split_cli_args(
     args: &[String],
     known_with_value: &[&str],
     known_switches: &[&str],
 ) -> (Vec<String>, Map<String, Value>) {
+    // `--repair -o out.glb`: `-o` is clap's, not the value of `repair` (a value may still start
+    // with one dash: `--lambda -0.25`).
+    let is_option = |a: &str| {
+        let flag = a.split_once('=').map_or(a, |(f, _)| f);
+        a.starts_with("--") || known_with_value.contains(&flag) || known_switches.contains(&flag)
+    };
     let mut clap_args = Vec::new();
     let mut params = Map::new();
     let mut i = 0;
@@ -48,7 +54,7 @@ pub fn split_cli_args(
         } else if let Some(name) = flag.strip_prefix("--") {
             let value = match inline {
                 Some(v) => parse_value(v),
-                None if i + 1 < args.len() && !args[i + 1].starts_with("--") => {
+                None if i + 1 < args.len() && !is_option(&args[i + 1]) => {
                     i += 1;
                     parse_value(&args[i])
                 }
@@ -117,5 +123,18 @@ mod tests {
         assert_eq!(parse_value("false"), json!(false));
         assert_eq!(parse_value("cotangent"), json!("cotangent"));
         assert_eq!(parse_value("\"12\""), json!("12"));
+    }
+
+    /// `meshwork morph a.obj b.obj --repair -o out.glb` used to take `-o` as the value of
+    /// `repair` and then fail with "-o OUT is required".
+    #[test]
+    fn a_bare_flag_before_a_short_option_is_true() {
+        let (clap, p) = split_cli_args(
+            &s(&["a.obj", "--repair", "-o", "out.glb", "--verbose-thing", "-q", "--lambda", "-0.5"]),
+            &["-o", "--output"],
+            &["-q", "--quiet"],
+        );
+        assert_eq!(clap, s(&["a.obj", "-o", "out.glb", "-q"]));
+        assert_eq!(Value::Object(p), json!({"repair": true, "verbose_thing": true, "lambda": -0.5}));
     }
 }

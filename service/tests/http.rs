@@ -513,3 +513,18 @@ fn fit_takes_template_and_curves_parts() {
     assert_eq!(m.groups.len(), 3, "the three regions survive as OBJ groups");
     assert!(m.positions.iter().all(|p| p[2].abs() < 1e-6), "the plane stays z = 0");
 }
+
+#[test]
+fn external_reference_in_gltf_is_422_naming_the_buffer() {
+    // A glTF whose buffer points at a file beside it: we never open files named by uploads.
+    let s = Server::start(&[]);
+    let gltf = br#"{"asset":{"version":"2.0"},
+        "buffers":[{"uri":"mesh.bin","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#;
+    let p = s.post("/v1/convert?format=obj", "model/gltf+json", gltf).problem(422, "external-reference");
+    assert_eq!(p["gltf_path"], "buffers[0].uri", "{p}");
+    assert!(p["detail"].as_str().unwrap().contains("buffers[0].uri"), "{p}");
+}

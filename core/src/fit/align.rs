@@ -4,7 +4,7 @@
 //! sign choices are each refined by ICP and the best fit wins. Symmetric templates can still
 //! align in more than one way: pairs are the reliable route (the seed always uses them).
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::{add, dot, norm2, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
@@ -161,6 +161,7 @@ fn icp(
     let mut score = f64::INFINITY;
     for it in 0..=iterations {
         progress.check()?;
+        let last = score;
         let mut matches: Vec<(f64, Point3, Point3)> = Vec::with_capacity(curve.len());
         for &c in curve {
             if let Some((i, _)) = tree.nearest(m.inverse_apply(c)) {
@@ -172,7 +173,8 @@ fn icp(
             break;
         }
         score = (matches.iter().map(|x| x.0).sum::<f64>() / matches.len() as f64).sqrt();
-        if it == iterations {
+        // Converged (the score never rises: every step minimises the same sum over the matches).
+        if it == iterations || score >= last * (1.0 - 1e-7) {
             break;
         }
         let (mut from, mut to): (Vec<Point3>, Vec<Point3>) = matches.iter().map(|&(_, p, c)| (p, c)).unzip();
@@ -196,22 +198,61 @@ fn subsample(p: &[Point3], k: usize) -> Vec<Point3> {
     p.iter().step_by(step).copied().collect()
 }
 
-/// PCA start + similarity ICP. Returns the map template → curve space and its score (RMS
+/// A pose found by the PCA + ICP search: the map template → curve space and its ICP score (RMS
 /// distance of the curve points to their nearest template vertices).
-///
-/// Candidates: every proper rotation taking the template's principal axes onto the curves'
-/// (6 axis orders × 4 sign choices = 24). The axis *order* matters as much as the signs: the
-/// curves sample the surface unevenly (sections along one axis only, a partial network), so
-/// their spreads need not rank like the template's, and templates with two similar spreads
-/// (a flat figure, a round body) swap axes under any small change. Each candidate gets a short
-/// ICP on a subset of the curve points; the best three are refined on all of them.
+#[derive(Debug, Clone, Copy)]
+pub struct Candidate {
+    pub sim: Similarity,
+    pub icp_rms: f64,
+    /// Refined on the whole template (`icp_rms` is then against all template vertices; otherwise
+    /// against the subset, larger).
+    pub contender: bool,
+}
+
+/// Poses whose rotations differ by less than this are the same pose (ICP from two nearby starts).
+const SAME_POSE_DEG: f64 = 20.0;
+
+/// Template vertices used to score the 24 PCA starts (a spread subset: the starts only need
+/// ranking, and a query from a wrong pose, far from the surface, visits much of a large tree).
+const SCORING_TEMPLATE_POINTS: usize = 4000;
+
+/// Angle in degrees of the rotation taking `b` to `a` (from the trace of a·bᵀ).
+pub fn rotation_angle_deg(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> f64 {
+    let tr: f64 = (0..3).map(|i| dot(a[i], b[i])).sum();
+    ((tr - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// PCA start + similarity ICP: the best pose (see [`pca_icp_candidates`]).
 pub fn pca_icp(
     template: &[Point3],
     curve: &[Point3],
     iterations: u32,
     progress: &Progress,
 ) -> Result<(Similarity, f64)> {
-    let tree = KdTree::new(template);
+    let c = pca_icp_candidates(template, curve, iterations, 3, progress)?;
+    Ok(c.first()
+        .map_or((Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] }, f64::INFINITY), |c| (c.sim, c.icp_rms)))
+}
+
+/// PCA starts + similarity ICP. Returns up to three *distinct* poses (rotations more than
+/// [`SAME_POSE_DEG`] apart), best ICP score first.
+///
+/// Candidates: every proper rotation taking the template's principal axes onto the curves'
+/// (6 axis orders × 4 sign choices = 24). The axis *order* matters as much as the signs: the
+/// curves sample the surface unevenly (sections along one axis only, a partial network), so
+/// their spreads need not rank like the template's, and templates with two similar spreads
+/// (a flat figure, a round body) swap axes under any small change. Each candidate gets a short
+/// ICP on a subset of the curve points against a subset of the template; the best three distinct
+/// results are refined on all of them. Several are returned because a nearly symmetric template
+/// fits its mirror pose (a flat figure turned over is a proper rotation) almost as well: the
+/// caller breaks the tie with the smooth warp's residual and reports a tie it cannot break.
+pub fn pca_icp_candidates(
+    template: &[Point3],
+    curve: &[Point3],
+    iterations: u32,
+    keep: usize,
+    progress: &Progress,
+) -> Result<Vec<Candidate>> {
     let (at, st) = pca(template);
     let (ac, sc) = pca(curve);
     let (mt, mc) = (mean(template), mean(curve));
@@ -220,6 +261,8 @@ pub fn pca_icp(
             .sqrt();
     let s0 = if s0.is_finite() && s0 > 0.0 { s0 } else { 1.0 };
     let few = subsample(curve, 300);
+    let coarse_template = subsample(template, SCORING_TEMPLATE_POINTS);
+    let coarse_tree = KdTree::new(&coarse_template);
     let mut scored: Vec<(f64, Similarity)> = Vec::new();
     for perm in [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]] {
         for signs in [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]] {
@@ -240,19 +283,48 @@ pub fn pca_icp(
             }
             let rm = [dot(r[0], mt), dot(r[1], mt), dot(r[2], mt)];
             let start = Similarity { r, s: s0, t: sub(mc, scale(rm, s0)) };
-            let (m, score) = icp(template, &tree, &few, start, iterations.min(10), &[], 0, progress)?;
+            let (m, score) =
+                icp(&coarse_template, &coarse_tree, &few, start, iterations.min(10), &[], 0, progress)?;
             scored.push((score, m));
         }
     }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut best: Option<(Similarity, f64)> = None;
-    for (_, start) in scored.into_iter().take(3) {
-        let (m, score) = icp(template, &tree, curve, start, iterations, &[], 0, progress)?;
-        if best.as_ref().is_none_or(|b| score < b.1) {
-            best = Some((m, score));
+    let starts =
+        distinct(scored.into_iter().map(|(s, m)| Candidate { sim: m, icp_rms: s, contender: false }), keep);
+    // Every start on all curve points against the subset, then the contenders on the whole
+    // template (a wrong pose, far from the surface, is slow to query in a large tree).
+    let mut refined = Vec::with_capacity(starts.len());
+    for c in starts {
+        let (m, score) = icp(&coarse_template, &coarse_tree, curve, c.sim, iterations, &[], 0, progress)?;
+        refined.push(Candidate { sim: m, icp_rms: score, contender: false });
+    }
+    refined.sort_by(|a, b| a.icp_rms.total_cmp(&b.icp_rms));
+    let best = refined.first().map_or(f64::INFINITY, |c| c.icp_rms);
+    let tree = KdTree::new(template);
+    for c in refined.iter_mut() {
+        if c.icp_rms <= CONTENDER_RATIO * best {
+            let (m, score) = icp(template, &tree, curve, c.sim, iterations, &[], 0, progress)?;
+            *c = Candidate { sim: m, icp_rms: score, contender: true };
         }
     }
-    Ok(best.unwrap_or((Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] }, f64::INFINITY)))
+    refined.sort_by(|a, b| b.contender.cmp(&a.contender).then(a.icp_rms.total_cmp(&b.icp_rms)));
+    Ok(distinct(refined.into_iter(), usize::MAX))
+}
+
+/// Poses whose ICP score (against the template subset) is within this factor of the best are
+/// contenders: refined on the whole template and, in the fit, warped (the warp's residual
+/// chooses among them).
+pub const CONTENDER_RATIO: f64 = 1.5;
+
+/// The first `k` of `sorted` whose rotations are more than [`SAME_POSE_DEG`] from every one kept.
+fn distinct(sorted: impl Iterator<Item = Candidate>, k: usize) -> Vec<Candidate> {
+    let mut kept: Vec<Candidate> = Vec::new();
+    for c in sorted {
+        if kept.len() < k && kept.iter().all(|q| rotation_angle_deg(&q.sim.r, &c.sim.r) > SAME_POSE_DEG) {
+            kept.push(c);
+        }
+    }
+    kept
 }
 
 /// Similarity ICP started from the user's pairs, for pairs too degenerate for the coarse RBF
@@ -324,6 +396,9 @@ pub struct WarpReport {
     /// Trimmed RMS distance of the curve points to the surface before and after the warp.
     pub rms_before: f64,
     pub rms_after: f64,
+    /// RMS distance of all those curve points to the surface after the warp, none trimmed: the
+    /// points the trimming leaves out (curves running off the template) are what tells two poses apart.
+    pub rms_all_after: f64,
     /// Iterations whose step was halved because the full step folded faces.
     pub damped: u32,
 }
@@ -392,12 +467,6 @@ pub fn warp_icp(
     if points.len() < 10 || tris.is_empty() {
         return Ok(report);
     }
-    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
-    for (f, t) in tris.iter().enumerate() {
-        for &v in t {
-            vf[v as usize].push(f as u32);
-        }
-    }
     // A spread subset keeps each iteration cheap on dense networks.
     let stride = (points.len() / 1500).max(1);
     let which: Vec<u32> = (0..points.len() as u32).step_by(stride).collect();
@@ -406,7 +475,7 @@ pub fn warp_icp(
     if !(radius > 0.0) {
         return Ok(report);
     }
-    let u = |p: Point3| scale(sub(p, centre), 1.0 / radius);
+    let mut tracked = TrackedFeet::new(pos, tris, points, &which);
     let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
         let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
         d.sort_by(f64::total_cmp);
@@ -418,26 +487,25 @@ pub fn warp_icp(
     };
     let mut first = true;
     for (stage, degree) in [1usize, 2].into_iter().enumerate() {
+        let mut warp = LazyWarp::new(pos, centre, radius);
         let mut last_rms = f64::INFINITY;
         for _ in 0..iterations {
             progress.check()?;
-            let feet = super::insert::feet(pos, tris, &vf, points, &which)?;
+            let feet = tracked.feet(&mut warp, tris, points, &which)?;
             let (keep, rms) = trimmed(&feet);
             if first {
                 report.rms_before = rms;
                 first = false;
             }
-            report.rms_after = rms;
             if rms > 0.999 * last_rms || keep.len() < 10 {
                 break;
             }
             last_rms = rms;
-            report.iterations[stage] += 1;
             let n = monomials([0.0; 3], degree).1;
             let mut a = vec![0.0; n * n];
             let mut b = vec![[0.0; 3]; n];
             for &i in &keep {
-                let (m, _) = monomials(u(feet[i].1), degree);
+                let (m, _) = monomials(warp.u(feet[i].1), degree);
                 let r = sub(points[which[i] as usize], feet[i].1);
                 for j in 0..n {
                     for k in 0..n {
@@ -454,36 +522,203 @@ pub fn warp_icp(
                 a[j * n + j] += if j < 4 { 1e-3 * w } else { 1e-2 * w };
             }
             let Some(coef) = solve_spd(&a, &b, n) else { break };
-            let disp: Vec<Point3> = pos
-                .iter()
-                .map(|&p| {
-                    let (m, _) = monomials(u(p), degree);
-                    let mut d = [0.0; 3];
-                    for j in 0..n {
-                        d = add(d, scale(coef[j], m[j]));
-                    }
-                    d
-                })
-                .collect();
-            let mut step = 1.0;
-            let moved = loop {
-                let moved: Vec<Point3> =
-                    pos.iter().zip(&disp).map(|(p, d)| add(*p, scale(*d, step))).collect();
-                if super::approach::folds(pos, &moved, tris) == 0 {
-                    break Some(moved);
-                }
-                report.damped += 1;
-                step *= 0.5;
-                if step < 0.2 {
-                    break None;
-                }
-            };
-            let Some(moved) = moved else { break };
-            pos.copy_from_slice(&moved);
+            warp.steps.push(coef);
         }
+        // The steps are applied to the whole template once per stage, and checked for folds
+        // against the stage's start: when the composed warp folds a face, the longest run of
+        // first steps that does not is kept (found by bisection; folds are rare).
+        let mut moved = warp.apply_first(warp.steps.len(), progress)?;
+        if super::approach::folds(pos, &moved, tris) > 0 {
+            report.damped += 1;
+            let (mut ok, mut bad) = (0, warp.steps.len());
+            while bad - ok > 1 {
+                let mid = (ok + bad) / 2;
+                if super::approach::folds(pos, &warp.apply_first(mid, progress)?, tris) > 0 {
+                    bad = mid;
+                } else {
+                    ok = mid;
+                }
+            }
+            moved = warp.apply_first(ok, progress)?;
+            warp.steps.truncate(ok);
+        }
+        report.iterations[stage] = warp.steps.len() as u32;
+        pos.copy_from_slice(&moved);
+        tracked.rebase(pos);
     }
-    report.rms_after = trimmed(&super::insert::feet(pos, tris, &vf, points, &which)?).1;
+    let mut warp = LazyWarp::new(pos, centre, radius);
+    let feet = tracked.feet(&mut warp, tris, points, &which)?;
+    report.rms_after = trimmed(&feet).1;
+    report.rms_all_after = (feet.iter().map(|f| f.2 * f.2).sum::<f64>() / feet.len().max(1) as f64).sqrt();
     Ok(report)
+}
+
+/// The warp of one stage as a list of polynomial steps (x ↦ x + Σ cₖ mₖ((x − centre)/radius),
+/// each applied to the result of the ones before), evaluated only at the vertices asked for:
+/// the closest-point search touches a few hundred vertices per curve point, so moving the whole
+/// template every iteration (and rebuilding its search structure) was almost all of the warp's
+/// time on large templates. `cur[v]` is `base[v]` moved by the first `done[v]` steps.
+struct LazyWarp<'a> {
+    base: &'a [Point3],
+    cur: Vec<Point3>,
+    done: Vec<u32>,
+    steps: Vec<Vec<[f64; 3]>>,
+    centre: Point3,
+    radius: f64,
+}
+
+impl<'a> LazyWarp<'a> {
+    fn new(base: &'a [Point3], centre: Point3, radius: f64) -> Self {
+        LazyWarp { base, cur: base.to_vec(), done: vec![0; base.len()], steps: Vec::new(), centre, radius }
+    }
+
+    fn u(&self, p: Point3) -> Point3 {
+        scale(sub(p, self.centre), 1.0 / self.radius)
+    }
+
+    fn step(&self, k: usize, p: Point3) -> Point3 {
+        let coef = &self.steps[k];
+        let (m, _) = monomials(self.u(p), if coef.len() > 4 { 2 } else { 1 });
+        let mut d = p;
+        for (c, mj) in coef.iter().zip(m) {
+            d = add(d, scale(*c, mj));
+        }
+        d
+    }
+
+    /// Current position of vertex `v`.
+    fn at(&mut self, v: u32) -> Point3 {
+        let v = v as usize;
+        while (self.done[v] as usize) < self.steps.len() {
+            self.cur[v] = self.step(self.done[v] as usize, self.cur[v]);
+            self.done[v] += 1;
+        }
+        self.cur[v]
+    }
+
+    /// Every vertex moved by the first `k` steps.
+    fn apply_first(&self, k: usize, progress: &Progress) -> Result<Vec<Point3>> {
+        use rayon::prelude::*;
+        progress.check()?;
+        Ok(self
+            .base
+            .par_iter()
+            .map(|&p| {
+                let mut q = p;
+                for s in 0..k {
+                    q = self.step(s, q);
+                }
+                q
+            })
+            .collect())
+    }
+}
+
+/// Closest surface points of the curve points on a template that the warp moves by small smooth
+/// steps. The nearest vertex of each point is found once with a k-d tree, then followed from one
+/// iteration to the next by a greedy walk over the vertex graph (a step moves it by a few edges
+/// at most), so no search structure is rebuilt per iteration. The foot is the closest point of
+/// the faces around that vertex and its neighbours.
+struct TrackedFeet {
+    vf: Vec<Vec<u32>>,
+    vv: Vec<Vec<u32>>,
+    near: Vec<u32>,
+    /// Faces around `near[k]` and its neighbours, kept while `near[k]` stays.
+    faces: Vec<(u32, Vec<u32>)>,
+}
+
+impl TrackedFeet {
+    fn new(pos: &[Point3], tris: &[[u32; 3]], points: &[Point3], which: &[u32]) -> Self {
+        let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+        let mut vv: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+        for (f, t) in tris.iter().enumerate() {
+            for k in 0..3 {
+                vf[t[k] as usize].push(f as u32);
+                vv[t[k] as usize].push(t[(k + 1) % 3]);
+                vv[t[(k + 1) % 3] as usize].push(t[k]);
+            }
+        }
+        for n in vv.iter_mut() {
+            n.sort_unstable();
+            n.dedup();
+        }
+        let mut t =
+            TrackedFeet { vf, vv, near: Vec::new(), faces: vec![(u32::MAX, Vec::new()); which.len()] };
+        t.near = which.iter().map(|_| u32::MAX).collect();
+        t.rebase_with(pos, points, which);
+        t
+    }
+
+    fn rebase_with(&mut self, pos: &[Point3], points: &[Point3], which: &[u32]) {
+        let tree = KdTree::new(pos);
+        self.near =
+            which.iter().map(|&i| tree.nearest(points[i as usize]).map_or(u32::MAX, |(v, _)| v)).collect();
+    }
+
+    /// The template was moved as a whole: the walks go on from the same vertices.
+    fn rebase(&mut self, _pos: &[Point3]) {}
+
+    /// (face, foot, distance) per point of `which`.
+    fn feet(
+        &mut self,
+        warp: &mut LazyWarp,
+        tris: &[[u32; 3]],
+        points: &[Point3],
+        which: &[u32],
+    ) -> Result<Vec<(u32, Point3, f64)>> {
+        let mut out = Vec::with_capacity(which.len());
+        for (k, &i) in which.iter().enumerate() {
+            let p = points[i as usize];
+            let mut v = self.near[k];
+            if v == u32::MAX {
+                return Err(Error::Internal("empty template".into()));
+            }
+            let mut d = norm2(sub(warp.at(v), p));
+            loop {
+                let mut next = v;
+                for &w in &self.vv[v as usize] {
+                    let dw = norm2(sub(warp.at(w), p));
+                    if dw < d {
+                        (next, d) = (w, dw);
+                    }
+                }
+                if next == v {
+                    break;
+                }
+                v = next;
+            }
+            self.near[k] = v;
+            if self.faces[k].0 != v {
+                let cand = &mut self.faces[k].1;
+                cand.clear();
+                for &f in &self.vf[v as usize] {
+                    for &w in &tris[f as usize] {
+                        cand.extend_from_slice(&self.vf[w as usize]);
+                    }
+                }
+                cand.sort_unstable();
+                cand.dedup();
+                self.faces[k].0 = v;
+            }
+            let mut best: Option<(u32, Point3, f64)> = None;
+            for &f in &self.faces[k].1 {
+                let t = tris[f as usize];
+                let q =
+                    crate::spatial::closest_on_triangle(p, &[warp.at(t[0]), warp.at(t[1]), warp.at(t[2])]);
+                let d = crate::geometry::dist(p, q);
+                if best.is_none_or(|b| d < b.2) {
+                    best = Some((f, q, d));
+                }
+            }
+            out.push(best.ok_or_else(|| {
+                Error::params(
+                    "template",
+                    format!("template vertex {v} (nearest to curve point {i}) has no face"),
+                )
+            })?);
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]

@@ -24,7 +24,38 @@ pub struct CoarseReport {
     pub icp_rms: Option<f64>,
     /// The smooth (affine, then quadratic) warp fitted after the ICP (`pca_icp` only).
     pub warp: Option<align::WarpReport>,
+    /// `pca_icp`: the distinct poses (rotations > 20° apart) the search kept, the chosen one
+    /// first; the contenders were warped and the one whose warp ends closest to the curves chosen.
+    pub candidates: Vec<CandidateReport>,
+    /// `pca_icp`: the runner-up pose fits the curves about as well as the chosen one
+    /// (score within [`AMBIGUOUS_RATIO`]) although it is turned far from it: typical of a
+    /// nearly symmetric template (a flat figure and its mirror image). The result may be the
+    /// wrong one of the two; give pairs.
+    pub ambiguous: bool,
+    /// Why `ambiguous` is set, in words, for the user.
+    pub warning: Option<String>,
 }
+
+/// One pose tried by the automatic alignment.
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateReport {
+    /// RMS distance of the curve points to their nearest template vertices after the ICP.
+    pub icp_rms: f64,
+    /// The next three are `None` for a pose not warped (its ICP score was far behind).
+    /// RMS distance of all curve points to the surface after the smooth warp (none trimmed).
+    pub warp_rms: Option<f64>,
+    /// Open template: RMS distance of the curve ends to the template's boundary after the warp
+    /// (each capped at 5% of the curves' bounding-box diagonal).
+    pub end_gap: Option<f64>,
+    /// The choosing score: √(warp_rms² + end_gap²), smallest wins.
+    pub score: Option<f64>,
+    /// Rotation from the chosen pose, degrees.
+    pub angle_deg: f64,
+}
+
+/// A runner-up whose score is within this factor of the winner's makes the choice ambiguous
+/// (see [`CoarseReport::ambiguous`]).
+pub const AMBIGUOUS_RATIO: f64 = 1.25;
 
 impl CoarseReport {
     /// (curve point, template vertex) of every user pair, the points the later stages hold fixed.
@@ -81,6 +112,9 @@ pub(super) fn coarse_alignment(
             pair_snap_distance_max: snap_max,
             icp_rms: None,
             warp: None,
+            candidates: vec![],
+            ambiguous: false,
+            warning: None,
         });
     }
     if matches!(params.alignment, Alignment::None) {
@@ -90,20 +124,136 @@ pub(super) fn coarse_alignment(
             pair_snap_distance_max: 0.0,
             icp_rms: None,
             warp: None,
+            candidates: vec![],
+            ambiguous: false,
+            warning: None,
         });
     }
-    let (sim, rms) = align::pca_icp(pos, &net.points, 30, progress)?;
-    for p in pos.iter_mut() {
-        *p = sim.apply(*p);
+    automatic(pos, tris, net, progress)
+}
+
+/// No pairs: PCA + similarity ICP, then the smooth warp from every contender pose (ICP score
+/// close to the best); the pose whose warp ends closest to the curves wins.
+///
+/// The ICP score alone cannot tell a nearly symmetric template from its mirror pose (both put
+/// every curve point near some template vertex), and on a flat template curves lying inside the
+/// outline fit anywhere. What tells poses apart is where the curves leave the template: the
+/// choosing score is the RMS distance of *all* curve points to the warped surface (the warp's
+/// own fit trims exactly the points that run off the template) and, on an open template, the
+/// RMS distance of the curve ends to its rim (sections of an open surface end on its boundary;
+/// each end's gap is capped at [`END_GAP_CAP`] of the curves' size, so a curve that really
+/// stops inside the surface weighs the same in every pose). A runner-up within
+/// [`AMBIGUOUS_RATIO`] of the winner is reported as an ambiguity rather than hidden.
+fn automatic(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    progress: &Progress,
+) -> Result<CoarseReport> {
+    let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
+    let rim = Rim::new(tris, net);
+    let mut tried: Vec<(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)> =
+        Vec::new();
+    for c in candidates {
+        let warped = if c.contender {
+            let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
+            let w = align::warp_icp(&mut p, tris, &net.points, WARP_ITERATIONS, progress)?;
+            let gap = rim.end_gap(&p);
+            let score = (w.rms_all_after.powi(2) + gap.unwrap_or(0.0).powi(2)).sqrt();
+            Some((p, w, score, gap))
+        } else {
+            None
+        };
+        tried.push((c, warped));
     }
-    let warp = align::warp_icp(pos, tris, &net.points, WARP_ITERATIONS, progress)?;
+    let score = |t: &(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)| {
+        t.1.as_ref().map_or(f64::INFINITY, |w| w.2)
+    };
+    tried.sort_by(|a, b| score(a).total_cmp(&score(b)));
+    let Some((chosen, Some((warped, warp, best, _)))) = tried.first().cloned() else {
+        return Err(Error::Internal("automatic alignment found no pose".into()));
+    };
+    pos.copy_from_slice(&warped);
+    let candidates: Vec<CandidateReport> = tried
+        .iter()
+        .map(|(c, w)| CandidateReport {
+            icp_rms: c.icp_rms,
+            warp_rms: w.as_ref().map(|w| w.1.rms_all_after),
+            end_gap: w.as_ref().and_then(|w| w.3),
+            score: w.as_ref().map(|w| w.2),
+            angle_deg: align::rotation_angle_deg(&c.sim.r, &chosen.sim.r),
+        })
+        .collect();
+    let runner_up = tried.get(1).map(score).unwrap_or(f64::INFINITY);
+    let ambiguous = runner_up <= AMBIGUOUS_RATIO * best;
+    let warning = ambiguous.then(|| {
+        format!(
+            "automatic alignment is ambiguous: a pose turned {:.0}° from the chosen one fits the curves almost \
+             as well (score {:.3e} vs {:.3e}); the template may be placed the wrong way round (e.g. as its \
+             mirror image): give correspondence pairs",
+            candidates[1].angle_deg, runner_up, best
+        )
+    });
     Ok(CoarseReport {
         method: "pca_icp",
         pair_curve_points: vec![],
         pair_snap_distance_max: 0.0,
-        icp_rms: Some(rms),
+        icp_rms: Some(chosen.icp_rms),
         warp: Some(warp),
+        candidates,
+        ambiguous,
+        warning,
     })
+}
+
+/// Each curve end's gap to the rim is capped at this × the curves' bounding-box diagonal (see
+/// [`automatic`]).
+pub const END_GAP_CAP: f64 = 0.05;
+
+/// The template's boundary edges and the curve ends, for the end-to-rim term of [`automatic`].
+struct Rim {
+    edges: Vec<(u32, u32)>,
+    ends: Vec<Point3>,
+    cap: f64,
+}
+
+impl Rim {
+    fn new(tris: &[[u32; 3]], net: &curves::CurveNetwork) -> Rim {
+        let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut edges: Vec<(u32, u32)> = count.into_iter().filter(|x| x.1 == 1).map(|x| x.0).collect();
+        edges.sort_unstable();
+        let all: Vec<Point3> =
+            (0..net.points.len()).filter(|&p| net.degree[p] == 1).map(|p| net.points[p]).collect();
+        // A spread subset bounds the cost (ends × rim edges) on networks with many loose ends.
+        let ends = all.iter().step_by(all.len().div_ceil(200).max(1)).copied().collect();
+        let cap = END_GAP_CAP * Aabb::of(&net.points).map_or(0.0, |b| b.diagonal());
+        Rim { edges, ends, cap }
+    }
+
+    /// RMS of the capped end-to-rim distances; `None` on a closed template or without ends.
+    fn end_gap(&self, pos: &[Point3]) -> Option<f64> {
+        if self.edges.is_empty() || self.ends.is_empty() {
+            return None;
+        }
+        let sum: f64 = self
+            .ends
+            .iter()
+            .map(|&e| {
+                self.edges
+                    .iter()
+                    .map(|&(a, b)| super::point_segment_distance(e, pos[a as usize], pos[b as usize]))
+                    .fold(self.cap, f64::min)
+                    .powi(2)
+            })
+            .sum();
+        Some((sum / self.ends.len() as f64).sqrt())
+    }
 }
 
 /// Pairs too few or too close to one line (on either side) for the coarse RBF, even with the
@@ -144,6 +294,9 @@ fn pairs_similarity(
         pair_snap_distance_max: snap_max,
         icp_rms: Some(rms),
         warp: Some(warp),
+        candidates: vec![],
+        ambiguous: false,
+        warning: None,
     })
 }
 

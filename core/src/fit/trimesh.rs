@@ -2,35 +2,11 @@
 //! the flip subdivision, the segment walk and the re-triangulation need (faces are removed and
 //! added one at a time). Requires an oriented edge-manifold input, which it checks.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use crate::error::{Error, Result};
 use crate::geometry::{add, normalize, sub, triangle_cross};
 use crate::mesh::Point3;
 
-/// Multiplicative hash for small integer keys (the std SipHash costs more than the work here).
-#[derive(Default)]
-pub struct IntHasher(u64);
-
-impl Hasher for IntHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
-        }
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(26) ^ i).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    }
-    fn finish(&self) -> u64 {
-        self.0 ^ (self.0 >> 29)
-    }
-}
-
-pub type IntMap<K, V> = HashMap<K, V, BuildHasherDefault<IntHasher>>;
+pub use crate::hash::{IntHasher, IntMap};
 
 /// The check [`TriMesh::new`] makes, without building the mesh: no face repeats a vertex and no
 /// directed edge is used twice (a sort, not a hash map: this runs on every template).

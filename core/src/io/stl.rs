@@ -14,6 +14,7 @@ use super::lex::{self, Tokens};
 use super::{Format, Loaded, ReadOptions};
 use crate::error::{Error, Location, Result};
 use crate::geometry;
+use crate::hash::BitsHasher;
 use crate::mesh::{Faces, Mesh};
 
 /// True when the length is exactly that of a binary STL with the triangle count in its header.
@@ -176,32 +177,6 @@ fn read_ascii(bytes: &[u8], opts: &ReadOptions) -> Result<(Soup, Vec<String>)> {
         return Err(ascii_err(last, "no facets"));
     }
     Ok((soup, groups))
-}
-
-/// A fast hasher for exact coordinate bit patterns (SipHash is needlessly slow here). Values are
-/// combined with a multiply and finished with the splitmix64 mixer, so coordinates whose low
-/// mantissa bits are all zero (0.5, 1.25, …: common in hand-made files) still spread over buckets.
-#[derive(Default)]
-struct BitsHasher(u64);
-
-impl Hasher for BitsHasher {
-    fn finish(&self) -> u64 {
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
-        }
-    }
-    fn write_usize(&mut self, v: usize) {
-        self.write_u64(v as u64);
-    }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(23) ^ v).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
 }
 
 /// Exact f32 coordinates as a weld key (-0 mapped to +0), hashed as two words.

@@ -4,39 +4,14 @@
 //! triangles. What a corner is and where it lies differ between the sphere and the plane; the
 //! walk and the bookkeeping do not, so they live here once.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hash, Hasher};
+use std::hash::Hash;
 
 use crate::error::Result;
+use crate::hash::IntMap;
 use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::correspond::Locator;
-
-/// FxHash (rustc's hasher): the overlay hashes millions of small integer labels, where SipHash's
-/// DoS resistance buys nothing and costs most of the stage's time.
-#[derive(Default)]
-pub(super) struct Fx(u64);
-impl Hasher for Fx {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
-        }
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-}
-pub(super) type FxMap<K, V> = HashMap<K, V, BuildHasherDefault<Fx>>;
 
 /// Calls `pair(fa, fb)` for every A-face `fa` and every B-face `fb` whose intersection can be
 /// non-empty, and returns how many pairs only touched (1 or 2 corners). `pair` intersects the two
@@ -92,7 +67,7 @@ pub(super) fn walk_face_pairs(
 /// (neighbouring polygons name a shared corner with the same label), each convex polygon fanned
 /// from its first corner.
 pub(super) struct PolygonFans<L> {
-    ids: FxMap<L, u32>,
+    ids: IntMap<L, u32>,
     pub tris: Vec<[u32; 3]>,
     poly: Vec<u32>,
 }
@@ -100,7 +75,7 @@ pub(super) struct PolygonFans<L> {
 impl<L: Copy + Eq + Hash> PolygonFans<L> {
     pub fn with_capacity(labels: usize) -> Self {
         PolygonFans {
-            ids: FxMap::with_capacity_and_hasher(labels, Default::default()),
+            ids: IntMap::with_capacity_and_hasher(labels, Default::default()),
             tris: Vec::new(),
             poly: Vec::with_capacity(12),
         }

@@ -16,11 +16,12 @@
 
 use crate::error::{Error, Result};
 use crate::geometry::{add, cross, dot, normalize, scale, sub};
+use crate::hash::IntMap;
 use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::correspond::{bary_on_chord, interpolate, Locator};
-use super::face_pairs::{walk_face_pairs, FxMap, PolygonFans};
+use super::face_pairs::{walk_face_pairs, PolygonFans};
 use super::param::orient;
 
 /// A spherical triangulation carrying one 3D position per vertex for each input shape.
@@ -274,8 +275,8 @@ fn push_shapes(
 
 /// Every directed edge must appear once, together with its reverse.
 fn check_closed_manifold(tris: &[[u32; 3]], nv: usize) -> Result<()> {
-    let mut half: FxMap<(u32, u32), u32> =
-        FxMap::with_capacity_and_hasher(tris.len() * 3, Default::default());
+    let mut half: IntMap<(u32, u32), u32> =
+        IntMap::with_capacity_and_hasher(tris.len() * 3, Default::default());
     for t in tris {
         for k in 0..3 {
             *half.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;

@@ -1,10 +1,12 @@
 //! The morph job (seeds 002/003): morph sequences between closed genus-0 meshes of different
 //! connectivity.
 //!
-//! The domain (spherical, or planar for disks: [`planar_job`]) and, with `repair`, the preparation
-//! of damaged inputs for it are decided first by [`domain`] (stage `repair`).
+//! The domain (spherical: `sphere_job`, or planar for disks: [`planar_job`]) and, with `repair`,
+//! the preparation of damaged inputs for it are decided first by [`domain`] (stage `repair`). The
+//! steps both domains share (triangulate and check the inputs, normalise, the output tail) are
+//! in `stages`.
 //!
-//! Pipeline, one timed stage each: `validate` (closed, connected, manifold, genus 0; outward
+//! Spherical pipeline, one timed stage each: `validate` (closed, connected, manifold, genus 0; outward
 //! orientation) → `normalise` (PCA frame with a deterministic sign rule, unit sphere; optional
 //! point-to-plane ICP onto input 0) → `parameterise` (per input, [`param`]: recorded QEM
 //! simplification, curvature-driven flattening or tetrahedron fallback, vertex splits,
@@ -34,19 +36,15 @@ pub mod pseudo;
 pub mod report;
 pub mod simplify;
 pub mod sphere_fallback;
+mod sphere_job;
+mod stages;
 pub mod trimesh;
 
 use serde::{Deserialize, Serialize};
-use serde_json::json;
 
 use crate::error::{Error, Result};
-use crate::geometry::signed_volume;
 use crate::job::{Output, Progress, Stages};
-use crate::mesh::{Faces, Mesh, Point3};
-use crate::register::{self, Similarity};
-
-use metamesh::Layer;
-use trimesh::TriMesh;
+use crate::mesh::Mesh;
 
 /// How the inputs are brought into one frame before parameterising.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, utoipa::ToSchema)]
@@ -239,283 +237,12 @@ fn input_name(k: usize) -> String {
 /// Inputs: 2..16 meshes (source, target, more for a multi-morph).
 pub fn run(inputs: Vec<Mesh>, params: &MorphParams, progress: &Progress) -> Result<Output> {
     params.check(inputs.len())?;
-    let k_in = inputs.len();
     let mut stages = Stages::new();
-
-    // 0. The domain, and with `repair` each input prepared for it (seed 003 §4.2), keeping track
-    //    of where each input vertex went so feature indices still mean the same vertex.
+    // The domain, and with `repair` each input prepared for it (seed 003 §4.2), keeping track of
+    // where each input vertex went so feature indices still mean the same vertex.
     let prep = domain::prepare(inputs, params, progress, &mut stages)?;
-    if prep.domain == domain::Chosen::Planar {
-        return planar_job::run(prep, params, progress, stages);
+    match prep.domain {
+        domain::Chosen::Planar => planar_job::run(prep, params, progress, stages),
+        domain::Chosen::Spherical => sphere_job::run(prep, params, progress, stages),
     }
-    let domain::Prepared { meshes: inputs, vertex_maps: repair_maps, repair: repair_reports, reason, .. } =
-        prep;
-
-    // 1. Validate.
-    let (meshes, maps, conv_reports, topo) = stages.run(progress, "validate", || {
-        let mut meshes = Vec::new();
-        let mut maps = Vec::new();
-        let mut convs = Vec::new();
-        let mut topo = Vec::new();
-        for (k, m) in inputs.iter().enumerate() {
-            domain::check_vertex_limit(k, m, params.max_vertices)?;
-            let (mut t, map, conv) = TriMesh::from_mesh(m);
-            let info = trimesh::topology(&t);
-            trimesh::require_sphere_like(&info, &input_name(k)).map_err(|e| match e {
-                Error::Topology(m) => Error::Topology(format!("{m}; spherical domain: {reason}")),
-                e => e,
-            })?;
-            let mut flipped = false;
-            if signed_volume(&t.pos, &Faces::from_triangles(&t.tris)) < 0.0 {
-                for tr in &mut t.tris {
-                    tr.swap(1, 2);
-                }
-                flipped = true;
-            }
-            convs.push(json!({"conversion": conv, "orientation_flipped": flipped}));
-            topo.push(info);
-            meshes.push(t);
-            maps.push(domain::compose_vertex_maps(repair_maps[k].as_deref(), map));
-        }
-        Ok((meshes, maps, convs, topo))
-    })?;
-
-    // Feature vertices, mapped to the triangulated inputs.
-    let features = map_features(&params.features, &maps, k_in)?;
-
-    // 2. Normalise.
-    let (normalised, frames_out, icp_reports) =
-        stages.run(progress, "normalise", || normalise(&meshes, params.registration, progress))?;
-
-    // 3. Parameterise every input (in parallel: they are independent).
-    let settings = param::ParamSettings {
-        working_vertices: if params.param_method == ParamMethod::Tetrahedron {
-            4
-        } else {
-            params.working_vertices
-        },
-        max_flatten_rounds: if params.param_method == ParamMethod::Tetrahedron {
-            0
-        } else {
-            params.max_flatten_rounds
-        },
-        relax_sweeps: params.relax_sweeps,
-        final_relax_sweeps: params.final_relax_sweeps,
-        sphere_method: params.sphere_method,
-        ..Default::default()
-    };
-    let maps_sph: Vec<param::SphereMap> = stages.run(progress, "parameterise", || {
-        use rayon::prelude::*;
-        normalised.par_iter().map(|m| param::parameterise(m, &settings, progress)).collect::<Result<Vec<_>>>()
-    })?;
-    for (k, m) in maps_sph.iter().enumerate() {
-        if m.report.foldovers > 0 {
-            return Err(Error::numerical(
-                "parameterise",
-                format!("{}: {} flipped spherical triangles remain", input_name(k), m.report.foldovers),
-            ));
-        }
-    }
-    let mut spheres: Vec<Vec<Point3>> = maps_sph.iter().map(|m| m.sphere.clone()).collect();
-
-    // 4. Feature alignment.
-    let align_rep = stages.run(progress, "align_features", || {
-        let tris: Vec<&[[u32; 3]]> = normalised.iter().map(|m| &m.tris[..]).collect();
-        align::align(
-            &mut spheres,
-            &tris,
-            &features,
-            &align::AlignSettings { steps: params.feature_steps, support_radius: params.support_radius },
-            progress,
-        )
-    })?;
-    if align_rep.foldovers > 0 {
-        return Err(Error::numerical(
-            "align_features",
-            format!("{} flipped triangles after the warp", align_rep.foldovers),
-        ));
-    }
-
-    // 5. Correspondence: chain overlays (or transfers) through the inputs.
-    let (layer, overlay_reps, fallback, pseudo_reps, perturbation) =
-        stages.run(progress, "metamesh", || {
-            let layers: Vec<Layer> = normalised
-                .iter()
-                .zip(&spheres)
-                .map(|(m, s)| Layer { sphere: s.clone(), tris: m.tris.clone(), shapes: vec![m.pos.clone()] })
-                .collect();
-            let mut acc = layers[0].clone();
-            let mut reps = Vec::new();
-            let mut fallback: Option<String> = None;
-            let mut pseudo_reps = Vec::new();
-            let mut perturbation = Vec::new();
-            for l in &layers[1..] {
-                acc = match params.correspondence {
-                    Correspondence::Overlay => match overlay_degenerate::overlay(&acc, l, progress) {
-                        Ok((o, r, angle)) => {
-                            reps.push(r);
-                            perturbation.push(angle);
-                            o
-                        }
-                        Err(Error::Numerical { message, .. }) => {
-                            fallback =
-                                Some(format!("overlay failed ({message}); used the barycentric transfer"));
-                            metamesh::transfer(&acc, l, progress)?
-                        }
-                        Err(e) => return Err(e),
-                    },
-                    Correspondence::Transfer => metamesh::transfer(&acc, l, progress)?,
-                    Correspondence::Pseudo => {
-                        let (p, r) = pseudo::pseudo(
-                            &acc,
-                            l,
-                            pseudo::Domain::Sphere,
-                            params.pseudo_max_depth,
-                            progress,
-                        )?;
-                        pseudo_reps.push(r);
-                        p
-                    }
-                };
-            }
-            Ok((acc, reps, fallback, pseudo_reps, perturbation))
-        })?;
-
-    // Back in input 0's coordinates.
-    let back = frames_out[0].inverse();
-    let shapes_out: Vec<Vec<Point3>> =
-        layer.shapes.iter().map(|s| s.iter().map(|&p| back.apply(p)).collect()).collect();
-    // 6–7. Interpolate, GLB (and the frames ZIP when asked for).
-    let (out_meshes, artifacts) =
-        output::write_outputs(&mut stages, progress, params, &layer.tris, &shapes_out)?;
-
-    // 8. Report: how well the end frames reproduce the inputs (in the normalised frames).
-    let hausdorff = stages.run(progress, "report", || {
-        Ok((0..k_in)
-            .map(|k| {
-                report::relative_hausdorff(
-                    &layer.shapes[k],
-                    &layer.tris,
-                    &normalised[k].pos,
-                    &normalised[k].tris,
-                    // Overlay faces lie inside input faces: their vertices bound the distance.
-                    overlay_reps.len() + 1 < k_in || params.correspondence != Correspondence::Overlay,
-                )
-            })
-            .collect::<Vec<f64>>())
-    })?;
-
-    let per_input: Vec<serde_json::Value> = (0..k_in)
-        .map(|k| {
-            json!({
-                "input": k,
-                "vertices": meshes[k].pos.len(),
-                "faces": meshes[k].tris.len(),
-                "topology": topo[k],
-                "preparation": conv_reports[k],
-                "parameterisation": maps_sph[k].report,
-                "hausdorff_to_input": hausdorff[k],
-            })
-        })
-        .collect();
-    let report = json!({
-        "inputs": k_in,
-        "angle_distortion": maps_sph.iter().map(|m| m.report.angle_distortion).collect::<Vec<_>>(),
-        "area_distortion": maps_sph.iter().map(|m| m.report.area_distortion).collect::<Vec<_>>(),
-        "foldovers": maps_sph.iter().map(|m| m.report.foldovers).collect::<Vec<_>>(),
-        "param_method": maps_sph.iter().map(|m| m.report.param_method.as_str()).collect::<Vec<_>>(),
-        "param_fallback_reason": maps_sph.iter().map(|m| m.report.param_fallback_reason.clone()).collect::<Vec<_>>(),
-        "metamesh_vertices": layer.sphere.len(),
-        "metamesh_faces": layer.tris.len(),
-        "correspondence": match (params.correspondence, &fallback) {
-            (Correspondence::Transfer, _) => "transfer",
-            (Correspondence::Pseudo, _) => "pseudo",
-            (_, Some(_)) => "transfer_fallback",
-            _ => "overlay",
-        },
-        "correspondence_fallback": fallback,
-        "overlays": overlay_reps,
-        // Radians the target's embedding was rotated so the overlay could be built (0: exact).
-        "overlay_perturbation": perturbation,
-        "pseudo_metamesh": pseudo_reps,
-        "domain": "spherical",
-        "domain_reason": reason,
-        "frames_zip": params.frames_zip,
-        "hausdorff_first_frame": hausdorff[0],
-        "hausdorff_last_frame": hausdorff[k_in - 1],
-        "hausdorff_per_input": hausdorff,
-        "warnings": report::feature_warnings(align_rep.feature_points, align_rep.max_feature_gap_after, "rad"),
-        "features": align_rep,
-        "icp": icp_reports,
-        "frames": params.frames,
-        "output_meshes": if params.blend_weights.is_some() { "blend" } else if params.output_frames { "frames" } else { "remeshed_inputs" },
-        "per_input": per_input,
-        "repair": repair_reports,
-        "total_ms": stages.total_ms(),
-        "stages": stages.to_json(),
-    });
-    Ok(Output { meshes: out_meshes, artifacts, report })
-}
-
-/// Step 2 of both domains: every input in its PCA frame (with `Registration::None`, every input in
-/// input 0's frame, so their relative placement is kept), then with `PcaIcp` rigid ICP of inputs
-/// 1.. onto input 0. Returns the normalised meshes, each input's frame (input → normalised) and the
-/// ICP results.
-pub(crate) fn normalise(
-    meshes: &[TriMesh],
-    registration: Registration,
-    progress: &Progress,
-) -> Result<(Vec<TriMesh>, Vec<Similarity>, Vec<register::IcpResult>)> {
-    let mut frames: Vec<Similarity> = Vec::new();
-    for m in meshes {
-        let f = if registration == Registration::None && !frames.is_empty() {
-            frames[0]
-        } else {
-            register::pca_frame(&m.pos, &m.tris).to_normalised
-        };
-        frames.push(f);
-    }
-    let mut norm: Vec<TriMesh> = meshes
-        .iter()
-        .zip(&frames)
-        .map(|(m, f)| TriMesh { pos: m.pos.iter().map(|&p| f.apply(p)).collect(), tris: m.tris.clone() })
-        .collect();
-    let mut icp = Vec::new();
-    if registration == Registration::PcaIcp {
-        let target = register::IcpTarget::new(&norm[0].pos, &norm[0].tris);
-        for k in 1..norm.len() {
-            progress.fraction(k as f64 / norm.len() as f64)?;
-            let r = register::icp(&norm[k].pos, &target, 50);
-            for p in &mut norm[k].pos {
-                *p = r.transform.apply(*p);
-            }
-            frames[k] = r.transform.then_after(&frames[k]);
-            icp.push(r);
-        }
-    }
-    Ok((norm, frames, icp))
-}
-
-/// Feature vertices (input indices) mapped to the triangulated inputs.
-fn map_features(features: &[Vec<u32>], maps: &[Vec<u32>], k_in: usize) -> Result<Vec<Vec<u32>>> {
-    let mut out = Vec::with_capacity(features.len());
-    for (i, f) in features.iter().enumerate() {
-        let mut row = Vec::with_capacity(k_in);
-        for k in 0..k_in {
-            let v = f[k] as usize;
-            let m = maps[k].get(v).copied().unwrap_or(u32::MAX);
-            if m == u32::MAX {
-                return Err(Error::params(
-                    format!("features[{i}][{k}]"),
-                    format!(
-                        "vertex {v} of {} does not exist, is used by no face, or was removed by the repair",
-                        input_name(k)
-                    ),
-                ));
-            }
-            row.push(m);
-        }
-        out.push(row);
-    }
-    Ok(out)
 }

@@ -184,4 +184,49 @@ mod tests {
         assert_eq!(p.extra["line"], 3);
         assert_eq!(Problem::from(&errors[9]).status, 504);
     }
+
+    /// Every core error kind, its HTTP status as docs/api.md promises it (written out here, not
+    /// read from `KINDS`), and the member naming where or what, when the kind has one.
+    #[test]
+    fn every_core_error_kind_maps_to_its_status_and_names_where() {
+        let cases: Vec<(Error, u16, Option<(&str, serde_json::Value)>)> = vec![
+            (Error::UnsupportedFormat("xyz".into()), 415, None),
+            (Error::malformed("ply", Location::Byte(17), "short"), 422, Some(("byte", 17.into()))),
+            (
+                Error::ExternalReference {
+                    location: Location::Gltf("buffers[0]".into()),
+                    message: "uri".into(),
+                },
+                422,
+                Some(("gltf_path", "buffers[0]".into())),
+            ),
+            (
+                Error::InvalidMesh { location: Location::Vertex(4), message: "NaN".into() },
+                422,
+                Some(("vertex", 4.into())),
+            ),
+            (Error::params("time_step", "must be > 0"), 422, Some(("field", "time_step".into()))),
+            (
+                Error::TooLarge { what: "vertices".into(), limit: 10, actual: 11 },
+                413,
+                Some(("limit", 10.into())),
+            ),
+            (Error::Topology("genus 1".into()), 422, None),
+            (Error::numerical("factor", "not positive definite"), 422, None),
+            (Error::Cancelled, 409, None),
+            (Error::TimedOut, 504, None),
+            (Error::Internal("bug".into()), 500, None),
+        ];
+        for (e, status, member) in &cases {
+            let p = Problem::from(e);
+            assert_eq!(p.status, *status, "{}", e.kind());
+            assert_eq!(p.type_, format!("/problems/{}", e.kind()));
+            assert_eq!(p.kind(), e.kind());
+            assert_eq!(p.detail, e.to_string(), "the detail is the core message, which says where");
+            if let Some((key, value)) = member {
+                assert_eq!(&p.extra[*key], value, "{}: {key}", e.kind());
+            }
+        }
+        assert_eq!(Problem::from(&cases[2].0).extra["location"], "buffers[0]");
+    }
 }
