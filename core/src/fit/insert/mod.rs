@@ -32,6 +32,9 @@ use super::curves::CurveNetwork;
 use super::kdtree::KdTree;
 use super::trimesh::TriMesh;
 
+pub mod order;
+pub mod walk;
+
 /// A foot whose largest barycentric coordinate is above 1 − this reuses that vertex.
 const VERTEX_SNAP: f64 = 0.3;
 /// A foot whose smallest barycentric coordinate is below this splits the opposite edge.
@@ -49,6 +52,13 @@ pub struct InsertStats {
     pub nudged: usize,
     /// Curve ends (network degree 1) matched on the template boundary (see [`super::ends`]).
     pub ends_on_boundary: usize,
+    /// Curve points whose foot was searched along their curve ([`walk`]) and differs from their
+    /// closest point (which was on a part of the template the curve does not pass).
+    pub walked_feet: usize,
+    /// Segments whose feet step out of the curve's order ([`order`]) with plain closest points,
+    /// and with the walked feet used.
+    pub out_of_order_closest: usize,
+    pub out_of_order: usize,
     /// Distance from each curve vertex to its template vertex before the fine deformation.
     pub distance_max: f64,
     pub distance_mean: f64,
@@ -64,7 +74,7 @@ pub struct Inserted {
 
 /// Inserts every curve vertex not fixed by a user pair. `fixed` = (curve point, template vertex).
 /// Curve ends within `end_snap` (a distance) of the template boundary are inserted on the
-/// boundary. On return `pos`/`tris` are the refined template.
+/// boundary. Feet follow their curve ([`walk`]). On return `pos`/`tris` are the refined template.
 pub fn insert_curve_points(
     pos: &mut Vec<Point3>,
     tris: &mut Vec<[u32; 3]>,
@@ -74,13 +84,7 @@ pub fn insert_curve_points(
     progress: &Progress,
 ) -> Result<Inserted> {
     let n = net.points.len();
-    let nv0 = pos.len();
-    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
-    for (f, t) in tris.iter().enumerate() {
-        for &v in t {
-            vf[v as usize].push(f as u32);
-        }
-    }
+    let vf = vertex_faces(pos.len(), tris);
     let all: Vec<u32> = (0..n as u32).collect();
     let mut feet = feet(pos, tris, &vf, &net.points, &all)?;
     let on_rim = super::ends::boundary_feet(pos, tris, net, end_snap);
@@ -88,79 +92,150 @@ pub fn insert_curve_points(
         feet[b.point_index as usize] = (b.face, b.foot, b.distance);
     }
     let mut vop = vec![u32::MAX; n];
-    let mut claimed = vec![false; nv0];
+    // Anchors keep their own feet: feature points, curve ends, user pairs, ends on the rim.
+    let mut anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
     for &(p, v) in fixed {
         vop[p as usize] = v;
-        claimed[v as usize] = true;
+        anchor[p as usize] = true;
     }
-    // Shortest segment at each curve point: a snap may move the point's template vertex by at most
-    // a quarter of it, or dense curves would swap order on the surface.
-    let mut spacing = vec![f64::INFINITY; n];
+    for b in &on_rim {
+        anchor[b.point_index as usize] = true;
+    }
+    let foot_points = |feet: &[(u32, Point3, f64)]| feet.iter().map(|f| f.1).collect::<Vec<_>>();
+    let out_of_order_closest = order::out_of_order_segments(net, &foot_points(&feet));
+    let walked = walk::walk_feet(pos, tris, &vf, net, &mut feet, &anchor);
+    let out_of_order = order::out_of_order_segments(net, &foot_points(&feet));
+    let spacing = shortest_segments(net);
+    let mut queue: Vec<u32> = (0..n as u32).filter(|&p| vop[p as usize] == u32::MAX).collect();
+    queue.sort_by(|&a, &b| {
+        net.is_feature(b).cmp(&net.is_feature(a)).then(feet[a as usize].2.total_cmp(&feet[b as usize].2))
+    });
+    let mut ins = Inserter::new(std::mem::take(pos), tris, &vf, &feet, fixed)?;
+    drop(vf);
+    ins.stats.ends_on_boundary = on_rim.len();
+    for (k, &p) in queue.iter().enumerate() {
+        if k % 1024 == 0 {
+            progress.fraction(k as f64 / n.max(1) as f64)?;
+        }
+        vop[p as usize] = ins.at_foot(p, feet[p as usize], 0.25 * spacing[p as usize])?;
+    }
+    ins.stats.walked_feet = walked;
+    ins.stats.out_of_order_closest = out_of_order_closest;
+    ins.stats.out_of_order = out_of_order;
+    let d: Vec<f64> = (0..n).map(|p| dist(net.points[p], ins.mesh.pos[vop[p] as usize])).collect();
+    ins.stats.distance_max = d.iter().cloned().fold(0.0, f64::max);
+    ins.stats.distance_mean = d.iter().sum::<f64>() / n.max(1) as f64;
+    let (created_in, stats) = ins.finish(pos, tris);
+    Ok(Inserted { vertex_of_point: vop, created_in, stats })
+}
+
+/// Faces around each vertex.
+fn vertex_faces(nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(f as u32);
+        }
+    }
+    vf
+}
+
+/// Shortest segment at each curve point: a snap may move the point's template vertex by at most
+/// a quarter of it, or dense curves would swap order on the surface.
+fn shortest_segments(net: &CurveNetwork) -> Vec<f64> {
+    let mut spacing = vec![f64::INFINITY; net.points.len()];
     for s in &net.segments {
         let l = dist(net.points[s[0] as usize], net.points[s[1] as usize]);
         for &p in s {
             spacing[p as usize] = spacing[p as usize].min(l);
         }
     }
-    let mut order: Vec<u32> = (0..n as u32).filter(|&p| vop[p as usize] == u32::MAX).collect();
-    order.sort_by(|&a, &b| {
-        net.is_feature(b).cmp(&net.is_feature(a)).then(feet[a as usize].2.total_cmp(&feet[b as usize].2))
-    });
+    spacing
+}
 
-    // Only the feet faces and their edge neighbours can be split: an editable mesh of those alone
-    // (local ids) keeps this step proportional to the curve, not to the template.
-    const NONE: u32 = u32::MAX;
-    let mut local_of = vec![NONE; tris.len()];
-    let mut local: Vec<u32> = Vec::new();
-    for &(f, _, _) in &feet {
-        let t = tris[f as usize];
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            for &g in &vf[a as usize] {
-                if local_of[g as usize] == NONE && tris[g as usize].contains(&b) {
-                    local_of[g as usize] = local.len() as u32;
-                    local.push(g);
+const NONE: u32 = u32::MAX;
+
+/// The template being refined: an editable mesh of the faces that can change (local ids), with
+/// the faces that tile each local template face and every new vertex's origin.
+struct Inserter {
+    mesh: TriMesh,
+    /// Template face of each local face, and the local face of each template face (or NONE).
+    local: Vec<u32>,
+    local_of: Vec<u32>,
+    /// Faces of the mesh that tile each local template face (children of splits keep the origin).
+    kids: Vec<Vec<u32>>,
+    origin: Vec<u32>,
+    created_in: Vec<Option<(u32, [f64; 3])>>,
+    claimed: Vec<bool>,
+    stats: InsertStats,
+}
+
+impl Inserter {
+    /// Only the feet faces and their edge neighbours are editable: this keeps the step
+    /// proportional to the curve, not to the template.
+    fn new(
+        pos: Vec<Point3>,
+        tris: &[[u32; 3]],
+        vf: &[Vec<u32>],
+        feet: &[(u32, Point3, f64)],
+        fixed: &[(u32, u32)],
+    ) -> Result<Self> {
+        let nv0 = pos.len();
+        let mut local_of = vec![NONE; tris.len()];
+        let mut local: Vec<u32> = Vec::new();
+        for &(f, _, _) in feet {
+            let t = tris[f as usize];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for &g in &vf[a as usize] {
+                    if local_of[g as usize] == NONE && tris[g as usize].contains(&b) {
+                        local_of[g as usize] = local.len() as u32;
+                        local.push(g);
+                    }
                 }
             }
         }
-    }
-    drop(vf);
-    let local_tris: Vec<[u32; 3]> = local.iter().map(|&f| tris[f as usize]).collect();
-    let mut mesh = TriMesh::new(std::mem::take(pos), local_tris)?;
-    // Faces of the mesh that tile each local template face (children of splits keep the origin).
-    let mut kids: Vec<Vec<u32>> = (0..mesh.tris.len() as u32).map(|f| vec![f]).collect();
-    let mut origin: Vec<u32> = (0..mesh.tris.len() as u32).collect();
-    let mut created_in: Vec<Option<(u32, [f64; 3])>> = vec![None; nv0];
-    let mut stats = InsertStats { ends_on_boundary: on_rim.len(), ..Default::default() };
-
-    for (k, &p) in order.iter().enumerate() {
-        if k % 1024 == 0 {
-            progress.fraction(k as f64 / n.max(1) as f64)?;
+        let local_tris: Vec<[u32; 3]> = local.iter().map(|&f| tris[f as usize]).collect();
+        let mesh = TriMesh::new(pos, local_tris)?;
+        let mut claimed = vec![false; nv0];
+        for &(_, v) in fixed {
+            claimed[v as usize] = true;
         }
-        let (tf_template, mut x, _) = feet[p as usize];
-        let tf = local_of[tf_template as usize];
+        Ok(Inserter {
+            kids: (0..mesh.tris.len() as u32).map(|f| vec![f]).collect(),
+            origin: (0..mesh.tris.len() as u32).collect(),
+            mesh,
+            local,
+            local_of,
+            created_in: vec![None; nv0],
+            claimed,
+            stats: InsertStats::default(),
+        })
+    }
+
+    /// Inserts curve point `p` at its foot (template face, point, distance): reuses a free vertex
+    /// or splits an edge within `max_move` of the foot, else splits the face there.
+    fn at_foot(&mut self, p: u32, (tf_template, mut x, _): (u32, Point3, f64), max_move: f64) -> Result<u32> {
+        let tf = self.local_of[tf_template as usize];
         let mut nudges = 0;
         let v = loop {
-            let (c, l) = locate(&mesh, &kids[tf as usize], x)
+            let (c, l) = locate(&self.mesh, &self.kids[tf as usize], x)
                 .ok_or_else(|| Error::Internal(format!("curve point {p}: foot not found in its face")))?;
-            let t = mesh.tris[c as usize];
+            let t = self.mesh.tris[c as usize];
             let (imax, lmax) = argmax(l);
             let (imin, lmin) = argmin(l);
-            let max_move = 0.25 * spacing[p as usize];
             if lmax > 1.0 - VERTEX_SNAP {
                 let v = t[imax];
-                if !claimed[v as usize] && dist(mesh.pos[v as usize], x) <= max_move {
-                    stats.reused_vertices += 1;
+                if !self.claimed[v as usize] && dist(self.mesh.pos[v as usize], x) <= max_move {
+                    self.stats.reused_vertices += 1;
                     break v;
                 }
                 if lmax > 1.0 - 1e-6 || nudges > 0 {
                     // The exact foot is a claimed vertex: move it into the face (a few % of the face).
                     nudges += 1;
-                    stats.nudged += (nudges == 1) as usize;
-                    let centroid = scale(
-                        add(add(mesh.pos[t[0] as usize], mesh.pos[t[1] as usize]), mesh.pos[t[2] as usize]),
-                        1.0 / 3.0,
-                    );
+                    self.stats.nudged += (nudges == 1) as usize;
+                    let p3 = |i: usize| self.mesh.pos[t[i] as usize];
+                    let centroid = scale(add(add(p3(0), p3(1)), p3(2)), 1.0 / 3.0);
                     x = add(scale(x, 0.8), scale(centroid, 0.2));
                     if nudges > 8 {
                         // Only a degenerate neighbourhood (zero-area faces) leaves no room: the
@@ -176,35 +251,55 @@ pub fn insert_curve_points(
                     continue;
                 }
             }
-            let tpos = tri_pos(&mesh, tf);
             // On the edge opposite imin: the point of that edge at the same ratio.
             let (a, b) = (t[(imin + 1) % 3], t[(imin + 2) % 3]);
             let (la, lb) = (l[(imin + 1) % 3], l[(imin + 2) % 3]);
             let s = lb / (la + lb);
-            let xe = add(scale(mesh.pos[a as usize], 1.0 - s), scale(mesh.pos[b as usize], s));
-            let m = if lmin < EDGE_SNAP && (lmin == 0.0 || dist(xe, x) <= max_move) {
-                stats.edge_splits += 1;
-                split_edge(&mut mesh, a, b, xe, &mut kids, &mut origin)
+            let xe = add(scale(self.mesh.pos[a as usize], 1.0 - s), scale(self.mesh.pos[b as usize], s));
+            break if lmin < EDGE_SNAP && (lmin == 0.0 || dist(xe, x) <= max_move) {
+                self.stats.edge_splits += 1;
+                self.split_edge_at(a, b, xe)
             } else {
-                stats.face_splits += 1;
-                split_face(&mut mesh, c, x, &mut kids, &mut origin)
+                self.stats.face_splits += 1;
+                let m = split_face(&mut self.mesh, c, x, &mut self.kids, &mut self.origin);
+                self.created(m, tf);
+                m
             };
-            created_in.push(Some((tf_template, barycentric(mesh.pos[m as usize], &tpos))));
-            claimed.push(false);
-            break m;
         };
-        claimed[v as usize] = true;
-        vop[p as usize] = v;
+        self.claimed[v as usize] = true;
+        Ok(v)
     }
-    let d: Vec<f64> = (0..n).map(|p| dist(net.points[p], mesh.pos[vop[p] as usize])).collect();
-    stats.distance_max = d.iter().cloned().fold(0.0, f64::max);
-    stats.distance_mean = d.iter().sum::<f64>() / n.max(1) as f64;
-    let mut out: Vec<[u32; 3]> =
-        tris.iter().enumerate().filter(|(f, _)| local_of[*f] == NONE).map(|(_, t)| *t).collect();
-    out.extend(mesh.live_triangles());
-    *tris = out;
-    *pos = mesh.pos;
-    Ok(Inserted { vertex_of_point: vop, created_in, stats })
+
+    /// Splits edge (a, b) at `x` (on it), recording where the new vertex was made.
+    fn split_edge_at(&mut self, a: u32, b: u32, x: Point3) -> u32 {
+        let f = self.mesh.face_with_edge(a, b).or_else(|| self.mesh.face_with_edge(b, a));
+        let org = f.map_or(0, |f| self.origin[f as usize]);
+        let m = split_edge(&mut self.mesh, a, b, x, &mut self.kids, &mut self.origin);
+        self.created(m, org);
+        m
+    }
+
+    /// Records new vertex `m`, made inside local template face `tf`.
+    fn created(&mut self, m: u32, tf: u32) {
+        let tpos = tri_pos(&self.mesh, tf);
+        self.created_in.push(Some((self.local[tf as usize], barycentric(self.mesh.pos[m as usize], &tpos))));
+        self.claimed.push(false);
+    }
+
+    /// The refined template back into `pos`/`tris` (the faces never edited, then the local mesh).
+    fn finish(
+        self,
+        pos: &mut Vec<Point3>,
+        tris: &mut Vec<[u32; 3]>,
+    ) -> (Vec<Option<(u32, [f64; 3])>>, InsertStats) {
+        let local_of = &self.local_of;
+        let mut out: Vec<[u32; 3]> =
+            tris.iter().enumerate().filter(|(f, _)| local_of[*f] == NONE).map(|(_, t)| *t).collect();
+        out.extend(self.mesh.live_triangles());
+        *tris = out;
+        *pos = self.mesh.pos;
+        (self.created_in, self.stats)
+    }
 }
 
 /// Closest point of each curve point on the template: (face, point, distance). Candidates are the
@@ -382,5 +477,63 @@ mod tests {
         for (a, b) in l.iter().zip([0.34, 0.33, 0.33]) {
             assert!((a - b).abs() < 1e-12);
         }
+    }
+
+    /// Two sheets 0.1 apart (z = 0 and z = 0.1, unit squares split into 8 × 8 × 2 triangles, not
+    /// connected) and a curve along x over the lower one at z = 0.03, except two points that
+    /// bulge to z = 0.07: closer to the upper sheet (0.03) than to the lower (0.07). Hand truth:
+    /// the curve runs along the lower sheet, so every curve vertex is inserted there (z = 0), in
+    /// x order. Plain closest points put the two bulging points on the upper sheet.
+    #[test]
+    fn feet_follow_their_curve_instead_of_jumping_to_a_nearby_sheet() {
+        let n = 8;
+        let mut pos = Vec::new();
+        let mut tris = Vec::new();
+        for (sheet, z) in [0.0, 0.1].into_iter().enumerate() {
+            let base = pos.len() as u32;
+            for j in 0..=n {
+                for i in 0..=n {
+                    pos.push([i as f64 / n as f64, j as f64 / n as f64, z]);
+                }
+            }
+            let id = |i: u32, j: u32| base + j * (n + 1) + i;
+            for j in 0..n {
+                for i in 0..n {
+                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                    // The lower sheet faces −z, the upper +z (the outside of a thin plate).
+                    if sheet == 0 {
+                        tris.extend([[a, c, b], [a, d, c]]);
+                    } else {
+                        tris.extend([[a, b, c], [a, c, d]]);
+                    }
+                }
+            }
+        }
+        let pts: Vec<Point3> = (1..=9)
+            .map(|k| {
+                let z = if k == 5 || k == 6 { 0.07 } else { 0.03 };
+                [0.1 * k as f64 - 0.03, 0.45, z]
+            })
+            .collect();
+        let curves = crate::mesh::Mesh {
+            positions: pts.clone(),
+            curves: vec![(0..9).collect()],
+            ..Default::default()
+        };
+        let net = CurveNetwork::from_mesh(&curves, 1e-9).unwrap();
+        // The case this test is for: the bulging points' plain closest points are on the upper sheet.
+        let vf = vertex_faces(pos.len(), &tris);
+        let closest = feet(&pos, &tris, &vf, &pts, &[4, 5]).unwrap();
+        assert!(closest.iter().all(|f| (f.1[2] - 0.1).abs() < 1e-12));
+        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, &Progress::new()).unwrap();
+        assert_eq!(ins.stats.walked_feet, 2);
+        let mut last_x = f64::NEG_INFINITY;
+        for (p, &v) in ins.vertex_of_point.iter().enumerate() {
+            let x = pos[v as usize];
+            assert_eq!(x[2], 0.0, "curve point {p} inserted on the upper sheet");
+            assert!(x[0] > last_x, "curve point {p} out of order");
+            last_x = x[0];
+        }
+        assert_eq!(ins.stats.out_of_order, 0);
     }
 }
