@@ -314,6 +314,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
     // Output mesh: one group per region (per region × template group when the template had
     // groups), the curves as vertex chains.
+    // Faces in group order (stable), so an OBJ has one `g` block per group, not one per change.
+    let (out_tris, region, tg) = {
+        let mut order: Vec<usize> = (0..out_tris.len()).collect();
+        order.sort_by_key(|&i| (region[i], if keep_groups { tg[i] } else { 0 }));
+        let tg = if keep_groups { order.iter().map(|&i| tg[i]).collect() } else { tg };
+        (
+            order.iter().map(|&i| out_tris[i]).collect::<Vec<_>>(),
+            order.iter().map(|&i| region[i]).collect::<Vec<_>>(),
+            tg,
+        )
+    };
     let mut faces = Faces::with_capacity(out_tris.len(), out_tris.len() * 3);
     let mut group_names: Vec<String> = (0..region_count).map(|i| format!("region_{i}")).collect();
     if keep_groups {

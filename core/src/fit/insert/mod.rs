@@ -18,8 +18,6 @@
 //! only within a quarter of the curve's local segment length (dense curves get exact feet). A foot at an already claimed vertex is nudged towards the centre of its face so no
 //! two RBF centres coincide. Feature points go first so they get the exact vertex at crossings.
 
-use std::collections::HashMap;
-
 use serde::Serialize;
 
 use crate::error::{Error, Result};
@@ -420,12 +418,13 @@ fn split_edge(
     let faces: Vec<u32> =
         [mesh.face_with_edge(a, b), mesh.face_with_edge(b, a)].into_iter().flatten().collect();
     let m = mesh.add_vertex(x);
-    let mut split: HashMap<u32, ([u32; 3], u32)> = HashMap::new();
+    // In face order (a hash map here made the new face ids, and so the whole fit, vary run to run).
+    let mut split: Vec<([u32; 3], u32)> = Vec::with_capacity(2);
     for f in faces {
-        split.insert(f, (mesh.tris[f as usize], origin[f as usize]));
+        split.push((mesh.tris[f as usize], origin[f as usize]));
         mesh.remove_face(f);
     }
-    for (_, (t, org)) in split {
+    for (t, org) in split {
         // Rotate so the split edge is (t[0], t[1]).
         let k = (0..3)
             .find(|&k| (t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a))
