@@ -425,6 +425,16 @@ fn main() {
                     "== split {split}, every {thin}, smoothing {smooth}: flipped_faces {} folds {}",
                     out.report["flipped_faces"], out.report["folds"]
                 );
+                if std::env::var("FIT_FOLDS").is_ok() {
+                    let r = &out.report;
+                    println!(
+                        "  untangle {} | flipped after fine {} before smoothing {} | cleanup bad after {}",
+                        r["untangle"],
+                        r["flipped_faces_after_fine"],
+                        r["flipped_faces_before_smoothing"],
+                        r["cleanup"]["bad_faces_after"]
+                    );
+                }
                 diagnose(&c, &out.meshes[0], &out.report);
             }
         }

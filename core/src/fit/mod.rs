@@ -160,7 +160,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let fine_tris = if keep_groups { tris.clone() } else { Vec::new() };
     let fine_positions = mesh.pos.clone();
     let mut reference_normals = report::vertex_normals(&fine_positions, &tris);
-    let realised = stages.run(progress, "retriangulate", || {
+    let mut realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
     let fine_parents = parents.len();
@@ -182,9 +182,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Folds made by snapping vertices onto segments and by the re-triangulated strips, against the
     // fine surface; chain vertices stay fixed and curve edges locked.
     let untangle_retri = stages.run(progress, "untangle_retriangulated", || {
-        // (Boundary vertices are never moved by the untangling either.)
-        Ok(untangle::untangle(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
+        // (Boundary vertices are never moved by the untangling either.) Folds between fixed
+        // vertices may get a free vertex on one of their edges.
+        Ok(untangle::untangle_with_splits(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
     })?;
+    // Vertices those splits added: after the re-triangulation's in every per-vertex array.
+    for a in &untangle_retri.added {
+        parents.push(*a);
+        let n = add(reference_normals[a[0].0 as usize], reference_normals[a[1].0 as usize]);
+        reference_normals.push(crate::geometry::normalize(n));
+        realised.on_curve.push(false);
+    }
     let retri_tris = mesh.live_triangles();
     let angles_retri = report::angle_stats(&mesh.pos, &retri_tris);
     let (region0, mut region_count) =

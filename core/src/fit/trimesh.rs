@@ -34,6 +34,7 @@ pub fn check_oriented_manifold(tris: &[[u32; 3]]) -> Result<()> {
     Ok(())
 }
 
+#[derive(Clone)]
 pub struct TriMesh {
     pub pos: Vec<Point3>,
     pub tris: Vec<[u32; 3]>,
