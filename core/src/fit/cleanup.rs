@@ -20,9 +20,6 @@
 //! - a collapse keeps the mesh manifold (link condition: x and y share exactly the two
 //!   neighbours opposite their edge).
 
-use std::collections::HashSet;
-use std::hash::BuildHasherDefault;
-
 use serde::Serialize;
 
 use crate::error::Result;
@@ -31,9 +28,9 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::smooth::min_angle_quality;
-use super::trimesh::{IntHasher, IntMap, TriMesh};
+use super::trimesh::{IntMap, TriMesh};
 
-pub type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
+pub use super::trimesh::EdgeSet;
 
 /// Largest swept volume of a flip, relative to (area of the two faces)^1.5: 0.05 allows
 /// a dihedral angle up to about 19° between two equilateral faces (any flip touching a sliver,

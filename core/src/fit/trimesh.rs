@@ -8,6 +8,9 @@ use crate::mesh::Point3;
 
 pub use crate::hash::{IntHasher, IntMap};
 
+/// Undirected edges (smaller index first) that must stay: curve edges, locked edges.
+pub type EdgeSet = crate::hash::IntSet<(u32, u32)>;
+
 /// The check [`TriMesh::new`] makes, without building the mesh: no face repeats a vertex and no
 /// directed edge is used twice (a sort, not a hash map: this runs on every template).
 pub fn check_oriented_manifold(tris: &[[u32; 3]]) -> Result<()> {
@@ -112,6 +115,28 @@ impl TriMesh {
         }
     }
 
+    /// Splits edge (a, b) at `x` and the one or two faces on it (each into two with the same
+    /// orientation); the new vertex's id, or None when no face has the edge.
+    pub fn split_edge(&mut self, a: u32, b: u32, x: Point3) -> Option<u32> {
+        let faces: Vec<u32> =
+            [self.face_with_edge(a, b), self.face_with_edge(b, a)].into_iter().flatten().collect();
+        if faces.is_empty() {
+            return None;
+        }
+        let m = self.add_vertex(x);
+        for f in faces {
+            let t = self.tris[f as usize];
+            let k =
+                (0..3).find(|&k| (t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a))?;
+            let (p, q, r) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            self.remove_face(f);
+            // The removed face freed its directed edges; p→m, m→q and the edges at m are new.
+            self.add_face([p, m, r]).ok()?;
+            self.add_face([m, q, r]).ok()?;
+        }
+        Some(m)
+    }
+
     pub fn faces_of(&self, v: u32) -> &[u32] {
         &self.vfaces[v as usize]
     }
@@ -167,5 +192,30 @@ impl TriMesh {
     /// Edge length helper.
     pub fn len(&self, a: u32, b: u32) -> f64 {
         crate::geometry::norm(sub(self.pos[a as usize], self.pos[b as usize]))
+    }
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_split_interior_edge_makes_four_faces_around_the_new_vertex() {
+        let pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]];
+        let mut mesh = TriMesh::new(pos, vec![[0, 1, 2], [1, 3, 2]]).unwrap();
+        let m = mesh.split_edge(1, 2, [0.5, 0.5, 0.0]).unwrap();
+        assert_eq!(m, 4);
+        assert_eq!(mesh.faces_of(m).len(), 4);
+        assert_eq!(mesh.alive_faces().count(), 4);
+        assert!(!mesh.has_edge(1, 2));
+        // Same orientation: every live face is counter-clockwise in the plane.
+        for f in mesh.alive_faces() {
+            let t = mesh.tris[f as usize];
+            let c = crate::geometry::triangle_cross(
+                mesh.pos[t[0] as usize],
+                mesh.pos[t[1] as usize],
+                mesh.pos[t[2] as usize],
+            );
+            assert!(c[2] > 0.0, "{t:?}");
+        }
     }
 }

@@ -23,14 +23,11 @@
 //! walked strip), `split.rs` (edge splits along a segment), `fallback.rs` with `dijkstra.rs` and
 //! `route.rs`, `snap.rs` (moves onto a segment that turn no face over), `stats.rs` (the report).
 
-use std::collections::HashSet;
-use std::hash::BuildHasherDefault;
-
 use crate::error::Result;
 use crate::job::Progress;
 
 use super::curves::CurveNetwork;
-use super::trimesh::{IntHasher, TriMesh};
+use super::trimesh::TriMesh;
 
 mod cut;
 mod dijkstra;
@@ -44,7 +41,7 @@ mod walk;
 
 pub use stats::{FailedSegment, FallbackUse, RetriStats, LONG_DETOUR};
 
-type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
+use super::trimesh::EdgeSet;
 
 pub struct Realised {
     /// Per network segment: the mesh vertex chain from `segments[i][0]`'s vertex to `[1]`'s.

@@ -4,7 +4,6 @@
 //! no face turns over.
 
 use crate::geometry::{add, scale, sub};
-use crate::mesh::Point3;
 
 use super::super::trimesh::TriMesh;
 use super::cut::{crossing, Cut};
@@ -38,30 +37,10 @@ pub(super) fn split_crossings(
     for c in crossings {
         let (pl, pr) = (mesh.pos[c.l as usize], mesh.pos[c.r as usize]);
         let x = add(pl, scale(sub(pr, pl), c.lam));
-        let Some(m) = split_edge(mesh, c.l, c.r, x) else { return false };
+        let Some(m) = mesh.split_edge(c.l, c.r, x) else { return false };
         added.push([(c.l, 1.0 - c.lam), (c.r, c.lam), (c.l, 0.0)]);
         on_curve.push(true);
         chain.push(m);
     }
     true
-}
-
-/// Splits edge (a, b) at `x` and the one or two faces on it; the new vertex's id.
-fn split_edge(mesh: &mut TriMesh, a: u32, b: u32, x: Point3) -> Option<u32> {
-    let faces: Vec<u32> =
-        [mesh.face_with_edge(a, b), mesh.face_with_edge(b, a)].into_iter().flatten().collect();
-    if faces.is_empty() {
-        return None;
-    }
-    let m = mesh.add_vertex(x);
-    for f in faces {
-        let t = mesh.tris[f as usize];
-        let k = (0..3).find(|&k| (t[k] == a && t[(k + 1) % 3] == b) || (t[k] == b && t[(k + 1) % 3] == a))?;
-        let (p, q, r) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-        mesh.remove_face(f);
-        // The removed face freed its directed edges; p→m, m→q and the edges at m are new.
-        mesh.add_face([p, m, r]).ok()?;
-        mesh.add_face([m, q, r]).ok()?;
-    }
-    Some(m)
 }

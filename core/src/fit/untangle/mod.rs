@@ -12,22 +12,18 @@
 //!
 //! Positions of fixed vertices never change, so curve vertices stay exact.
 
-use std::collections::HashSet;
-use std::hash::BuildHasherDefault;
-
 use serde::Serialize;
 
 use crate::geometry::{add, dot, scale, sub, triangle_cross};
 use crate::mesh::Point3;
 
-use super::trimesh::{IntHasher, TriMesh};
+use super::trimesh::TriMesh;
 use super::uvs::{self, UvMove};
 
 mod energy;
 mod folds;
 mod kernel;
 mod patch;
-mod split;
 
 pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
 
@@ -36,7 +32,7 @@ pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
 /// is as wrong as a flipped one and one round-off away from it.
 pub(crate) const MIN_COS: f64 = 0.05;
 
-pub type EdgeSet = HashSet<(u32, u32), BuildHasherDefault<IntHasher>>;
+pub use super::trimesh::EdgeSet;
 
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct UntangleStats {
@@ -182,7 +178,7 @@ pub fn untangle_with_splits(
                 .max_by(|x, y| mesh.len(x.0, x.1).total_cmp(&mesh.len(y.0, y.1)));
             let Some((a, b)) = edge else { continue };
             let mid = scale(add(mesh.pos[a as usize], mesh.pos[b as usize]), 0.5);
-            let Some(m) = split::split_edge(mesh, a, b, mid) else { continue };
+            let Some(m) = mesh.split_edge(a, b, mid) else { continue };
             added.push((m, a, b));
             batch.push(UvMove { vertex: m, weights: [(a, 0.5), (b, 0.5), (a, 0.0)] });
         }
