@@ -1,0 +1,344 @@
+//! The non-rigid part of the automatic alignment: after the similarity ICP, an affine then a
+//! quadratic warp of the template fitted by trimmed ICP to the curve points, each stage cut back
+//! to its last step that folds no face.
+
+use crate::error::{Error, Result};
+use crate::geometry::{add, norm2, scale, sub};
+use crate::job::Progress;
+use crate::mesh::Point3;
+
+use super::super::kdtree::KdTree;
+use super::mean;
+
+/// What the smooth warp of [`warp_icp`] did (serialised into the report).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct WarpReport {
+    /// Iterations run per degree (affine, then quadratic).
+    pub iterations: [u32; 2],
+    /// Trimmed RMS distance of the curve points to the surface before and after the warp.
+    pub rms_before: f64,
+    pub rms_after: f64,
+    /// RMS distance of all those curve points to the surface after the warp, none trimmed: the
+    /// points the trimming leaves out (curves running off the template) are what tells two poses apart.
+    pub rms_all_after: f64,
+    /// Iterations whose step was halved because the full step folded faces.
+    pub damped: u32,
+}
+
+/// Monomials of degree ≤ 2 of `u` (1, u, v, w, u², v², w², uv, vw, wu); `degree` 1 keeps 4.
+fn monomials(u: Point3, degree: usize) -> ([f64; 10], usize) {
+    let m =
+        [1.0, u[0], u[1], u[2], u[0] * u[0], u[1] * u[1], u[2] * u[2], u[0] * u[1], u[1] * u[2], u[2] * u[0]];
+    (m, if degree >= 2 { 10 } else { 4 })
+}
+
+/// Solves the symmetric positive definite `n×n` system `a x = b` (3 right-hand sides) by
+/// Cholesky; `None` when it is not positive definite.
+fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Option<Vec<[f64; 3]>> {
+    let mut l = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..=i {
+            let s: f64 = a[i * n + j] - (0..j).map(|k| l[i * n + k] * l[j * n + k]).sum::<f64>();
+            if i == j {
+                if s <= 0.0 || !s.is_finite() {
+                    return None;
+                }
+                l[i * n + i] = s.sqrt();
+            } else {
+                l[i * n + j] = s / l[j * n + j];
+            }
+        }
+    }
+    let mut y = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for c in 0..3 {
+            y[i][c] = (b[i][c] - (0..i).map(|k| l[i * n + k] * y[k][c]).sum::<f64>()) / l[i * n + i];
+        }
+    }
+    let mut x = vec![[0.0; 3]; n];
+    for i in (0..n).rev() {
+        for c in 0..3 {
+            x[i][c] = (y[i][c] - (i + 1..n).map(|k| l[k * n + i] * x[k][c]).sum::<f64>()) / l[i * n + i];
+        }
+    }
+    Some(x)
+}
+
+/// Smooth non-rigid alignment after the similarity ICP: ICP with an affine, then a quadratic
+/// polynomial warp of the whole template (x ↦ x + Σ cₖ mₖ((x − centre)/radius)).
+///
+/// Why: a similarity cannot follow a target that is a stretched or bent copy of the template, and
+/// the closest-point steps after it (approach levels, fine fit) only correct the *normal* distance
+/// of each curve point to the surface: the tangential error a similarity leaves (measured on the
+/// bent sweep meshes: 3–4× the error left by a coarse RBF through 12 user pairs) stays, and the
+/// fine displacements are then large compared with the edges, which folds faces. A global warp
+/// with few parameters is stiff, so iterating closest points moves it tangentially too (the shape
+/// of the curve network pins it), which a sparse interpolating RBF cannot do.
+///
+/// Guards: matches farther than 2.5× the median are trimmed; every coefficient is pulled towards
+/// zero by a ridge term, the quadratic ones harder, so directions the curves do not determine
+/// (all curves on one plane) stay put; a step that would fold faces is halved (then stops).
+pub fn warp_icp(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    points: &[Point3],
+    iterations: u32,
+    progress: &Progress,
+) -> Result<WarpReport> {
+    let mut report = WarpReport::default();
+    if points.len() < 10 || tris.is_empty() {
+        return Ok(report);
+    }
+    // A spread subset keeps each iteration cheap on dense networks.
+    let stride = (points.len() / 1500).max(1);
+    let which: Vec<u32> = (0..points.len() as u32).step_by(stride).collect();
+    let centre = mean(points);
+    let radius = (points.iter().map(|p| norm2(sub(*p, centre))).sum::<f64>() / points.len() as f64).sqrt();
+    if !(radius > 0.0) {
+        return Ok(report);
+    }
+    let mut tracked = TrackedFeet::new(pos, tris, points, &which);
+    let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
+        let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
+        d.sort_by(f64::total_cmp);
+        let cut = 2.5 * d[d.len() / 2];
+        let keep: Vec<usize> = (0..feet.len()).filter(|&i| feet[i].2 <= cut.max(1e-300)).collect();
+        let rms =
+            (keep.iter().map(|&i| feet[i].2 * feet[i].2).sum::<f64>() / keep.len().max(1) as f64).sqrt();
+        (keep, rms)
+    };
+    let mut first = true;
+    for (stage, degree) in [1usize, 2].into_iter().enumerate() {
+        let mut warp = LazyWarp::new(pos, centre, radius);
+        let mut last_rms = f64::INFINITY;
+        for _ in 0..iterations {
+            progress.check()?;
+            let feet = tracked.feet(&mut warp, tris, points, &which)?;
+            let (keep, rms) = trimmed(&feet);
+            if first {
+                report.rms_before = rms;
+                first = false;
+            }
+            if rms > 0.999 * last_rms || keep.len() < 10 {
+                break;
+            }
+            last_rms = rms;
+            let n = monomials([0.0; 3], degree).1;
+            let mut a = vec![0.0; n * n];
+            let mut b = vec![[0.0; 3]; n];
+            for &i in &keep {
+                let (m, _) = monomials(warp.u(feet[i].1), degree);
+                let r = sub(points[which[i] as usize], feet[i].1);
+                for j in 0..n {
+                    for k in 0..n {
+                        a[j * n + k] += m[j] * m[k];
+                    }
+                    for c in 0..3 {
+                        b[j][c] += m[j] * r[c];
+                    }
+                }
+            }
+            // Ridge: light on the affine part, 10× on the quadratic part (relative to the count).
+            let w = keep.len() as f64;
+            for j in 0..n {
+                a[j * n + j] += if j < 4 { 1e-3 * w } else { 1e-2 * w };
+            }
+            let Some(coef) = solve_spd(&a, &b, n) else { break };
+            warp.steps.push(coef);
+        }
+        // The steps are applied to the whole template once per stage, and checked for folds
+        // against the stage's start: when the composed warp folds a face, the longest run of
+        // first steps that does not is kept (found by bisection; folds are rare).
+        let mut moved = warp.apply_first(warp.steps.len(), progress)?;
+        if super::super::approach::folds(pos, &moved, tris) > 0 {
+            report.damped += 1;
+            let (mut ok, mut bad) = (0, warp.steps.len());
+            while bad - ok > 1 {
+                let mid = (ok + bad) / 2;
+                if super::super::approach::folds(pos, &warp.apply_first(mid, progress)?, tris) > 0 {
+                    bad = mid;
+                } else {
+                    ok = mid;
+                }
+            }
+            moved = warp.apply_first(ok, progress)?;
+            warp.steps.truncate(ok);
+        }
+        report.iterations[stage] = warp.steps.len() as u32;
+        pos.copy_from_slice(&moved);
+        tracked.rebase(pos);
+    }
+    let mut warp = LazyWarp::new(pos, centre, radius);
+    let feet = tracked.feet(&mut warp, tris, points, &which)?;
+    report.rms_after = trimmed(&feet).1;
+    report.rms_all_after = (feet.iter().map(|f| f.2 * f.2).sum::<f64>() / feet.len().max(1) as f64).sqrt();
+    Ok(report)
+}
+
+/// The warp of one stage as a list of polynomial steps (x ↦ x + Σ cₖ mₖ((x − centre)/radius),
+/// each applied to the result of the ones before), evaluated only at the vertices asked for:
+/// the closest-point search touches a few hundred vertices per curve point, so moving the whole
+/// template every iteration (and rebuilding its search structure) was almost all of the warp's
+/// time on large templates. `cur[v]` is `base[v]` moved by the first `done[v]` steps.
+struct LazyWarp<'a> {
+    base: &'a [Point3],
+    cur: Vec<Point3>,
+    done: Vec<u32>,
+    steps: Vec<Vec<[f64; 3]>>,
+    centre: Point3,
+    radius: f64,
+}
+
+impl<'a> LazyWarp<'a> {
+    fn new(base: &'a [Point3], centre: Point3, radius: f64) -> Self {
+        LazyWarp { base, cur: base.to_vec(), done: vec![0; base.len()], steps: Vec::new(), centre, radius }
+    }
+
+    fn u(&self, p: Point3) -> Point3 {
+        scale(sub(p, self.centre), 1.0 / self.radius)
+    }
+
+    fn step(&self, k: usize, p: Point3) -> Point3 {
+        let coef = &self.steps[k];
+        let (m, _) = monomials(self.u(p), if coef.len() > 4 { 2 } else { 1 });
+        let mut d = p;
+        for (c, mj) in coef.iter().zip(m) {
+            d = add(d, scale(*c, mj));
+        }
+        d
+    }
+
+    /// Current position of vertex `v`.
+    fn at(&mut self, v: u32) -> Point3 {
+        let v = v as usize;
+        while (self.done[v] as usize) < self.steps.len() {
+            self.cur[v] = self.step(self.done[v] as usize, self.cur[v]);
+            self.done[v] += 1;
+        }
+        self.cur[v]
+    }
+
+    /// Every vertex moved by the first `k` steps.
+    fn apply_first(&self, k: usize, progress: &Progress) -> Result<Vec<Point3>> {
+        use rayon::prelude::*;
+        progress.check()?;
+        Ok(self
+            .base
+            .par_iter()
+            .map(|&p| {
+                let mut q = p;
+                for s in 0..k {
+                    q = self.step(s, q);
+                }
+                q
+            })
+            .collect())
+    }
+}
+
+/// Closest surface points of the curve points on a template that the warp moves by small smooth
+/// steps. The nearest vertex of each point is found once with a k-d tree, then followed from one
+/// iteration to the next by a greedy walk over the vertex graph (a step moves it by a few edges
+/// at most), so no search structure is rebuilt per iteration. The foot is the closest point of
+/// the faces around that vertex and its neighbours.
+struct TrackedFeet {
+    vf: Vec<Vec<u32>>,
+    vv: Vec<Vec<u32>>,
+    near: Vec<u32>,
+    /// Faces around `near[k]` and its neighbours, kept while `near[k]` stays.
+    faces: Vec<(u32, Vec<u32>)>,
+}
+
+impl TrackedFeet {
+    fn new(pos: &[Point3], tris: &[[u32; 3]], points: &[Point3], which: &[u32]) -> Self {
+        let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+        let mut vv: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+        for (f, t) in tris.iter().enumerate() {
+            for k in 0..3 {
+                vf[t[k] as usize].push(f as u32);
+                vv[t[k] as usize].push(t[(k + 1) % 3]);
+                vv[t[(k + 1) % 3] as usize].push(t[k]);
+            }
+        }
+        for n in vv.iter_mut() {
+            n.sort_unstable();
+            n.dedup();
+        }
+        let mut t =
+            TrackedFeet { vf, vv, near: Vec::new(), faces: vec![(u32::MAX, Vec::new()); which.len()] };
+        t.near = which.iter().map(|_| u32::MAX).collect();
+        t.rebase_with(pos, points, which);
+        t
+    }
+
+    fn rebase_with(&mut self, pos: &[Point3], points: &[Point3], which: &[u32]) {
+        let tree = KdTree::new(pos);
+        self.near =
+            which.iter().map(|&i| tree.nearest(points[i as usize]).map_or(u32::MAX, |(v, _)| v)).collect();
+    }
+
+    /// The template was moved as a whole: the walks go on from the same vertices.
+    fn rebase(&mut self, _pos: &[Point3]) {}
+
+    /// (face, foot, distance) per point of `which`.
+    fn feet(
+        &mut self,
+        warp: &mut LazyWarp,
+        tris: &[[u32; 3]],
+        points: &[Point3],
+        which: &[u32],
+    ) -> Result<Vec<(u32, Point3, f64)>> {
+        let mut out = Vec::with_capacity(which.len());
+        for (k, &i) in which.iter().enumerate() {
+            let p = points[i as usize];
+            let mut v = self.near[k];
+            if v == u32::MAX {
+                return Err(Error::Internal("empty template".into()));
+            }
+            let mut d = norm2(sub(warp.at(v), p));
+            loop {
+                let mut next = v;
+                for &w in &self.vv[v as usize] {
+                    let dw = norm2(sub(warp.at(w), p));
+                    if dw < d {
+                        (next, d) = (w, dw);
+                    }
+                }
+                if next == v {
+                    break;
+                }
+                v = next;
+            }
+            self.near[k] = v;
+            if self.faces[k].0 != v {
+                let cand = &mut self.faces[k].1;
+                cand.clear();
+                for &f in &self.vf[v as usize] {
+                    for &w in &tris[f as usize] {
+                        cand.extend_from_slice(&self.vf[w as usize]);
+                    }
+                }
+                cand.sort_unstable();
+                cand.dedup();
+                self.faces[k].0 = v;
+            }
+            let mut best: Option<(u32, Point3, f64)> = None;
+            for &f in &self.faces[k].1 {
+                let t = tris[f as usize];
+                let q =
+                    crate::spatial::closest_on_triangle(p, &[warp.at(t[0]), warp.at(t[1]), warp.at(t[2])]);
+                let d = crate::geometry::dist(p, q);
+                if best.is_none_or(|b| d < b.2) {
+                    best = Some((f, q, d));
+                }
+            }
+            out.push(best.ok_or_else(|| {
+                Error::params(
+                    "template",
+                    format!("template vertex {v} (nearest to curve point {i}) has no face"),
+                )
+            })?);
+        }
+        Ok(out)
+    }
+}
