@@ -24,8 +24,8 @@ use std::time::Instant;
 
 use meshwork_core::fit::testdata::{
     circle, disjoint_union, ellipsoid_sections, gltf_lines, ngon_sphere, obj_negative_indices,
-    plane_sections, polylines, quarter_arcs_with_gap, section_regions, sweep_planes, to_unit_box, with_holes,
-    with_zero_area_face,
+    plane_sections, polylines, quarter_arcs_with_gap, section_regions, sweep_planes, tilted_wave,
+    to_unit_box, with_holes, with_zero_area_face,
 };
 use meshwork_core::geometry::{cross, norm, sub, Aabb};
 use meshwork_core::io::{read, write, Format, ReadOptions};
@@ -368,14 +368,7 @@ fn cases() -> Vec<Case> {
     out.push(case(
         "single closed loop, non-planar (tilted wave)",
         || {
-            let pts: Vec<Point3> = (0..=60)
-                .map(|k| {
-                    let t = 2.0 * PI * k as f64 / 60.0;
-                    let z = 0.3 * (3.0 * t).sin();
-                    let r = (1.0 - z * z).sqrt();
-                    [r * t.cos(), r * t.sin(), z]
-                })
-                .collect();
+            let pts = tilted_wave(60, true);
             Ok(vec![icosphere(3, 1.0), polylines(&[pts])])
         },
         none(),

@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 
 use meshwork_core::fit::testdata::{
     arc, circle, disjoint_union, ellipsoid_sections, gltf_lines, ngon_sphere, obj_negative_indices,
-    polylines, quarter_arcs_with_gap, with_holes, with_zero_area_face,
+    polylines, quarter_arcs_with_gap, tilted_wave, with_holes, with_zero_area_face,
 };
 use meshwork_core::geometry::{cross, norm, sub, Aabb};
 use meshwork_core::io::{read, ReadOptions};
@@ -200,14 +200,7 @@ fn curve_files_as_other_programs_write_them() {
     let obj = read_as(&obj_negative_indices(&c), "c.obj").unwrap();
     check(&fit(icosphere(3, 1.0), obj, json!({})).unwrap(), 8);
     // glTF LINE_LOOP: a closed non-planar wave around the sphere (the loop closes itself).
-    let wave: Vec<Point3> = (0..60)
-        .map(|k| {
-            let t = 2.0 * PI * k as f64 / 60.0;
-            let z = 0.3 * (3.0 * t).sin();
-            let r = (1.0 - z * z).sqrt();
-            [r * t.cos(), r * t.sin(), z]
-        })
-        .collect();
+    let wave = tilted_wave(60, false);
     let idx: Vec<u32> = (0..60).collect();
     let looped = read_as(&gltf_lines(&wave, &idx, 2), "c.gltf").unwrap();
     assert_eq!(looped.curves[0].len(), 61);

@@ -634,3 +634,17 @@ pub fn quarter_arcs_with_gap(axes: [f64; 3], gap: f64) -> Mesh {
     }
     polylines(&lines)
 }
+
+/// A closed wave on the unit sphere: z = 0.3 sin 3t at longitude t, `samples` points at
+/// t = 2πk/samples for k in 0..samples, plus the point at t = 2π (equal to the first up to
+/// rounding) when `repeat_start` (a polyline closed by its end point rather than by LINE_LOOP).
+pub fn tilted_wave(samples: usize, repeat_start: bool) -> Vec<Point3> {
+    (0..samples + usize::from(repeat_start))
+        .map(|k| {
+            let t = 2.0 * std::f64::consts::PI * k as f64 / samples as f64;
+            let z = 0.3 * (3.0 * t).sin();
+            let r = (1.0 - z * z).sqrt();
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect()
+}

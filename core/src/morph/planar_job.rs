@@ -58,12 +58,7 @@ pub fn run(prep: Prepared, params: &MorphParams, progress: &Progress, mut stages
     let align_rep = stages.run(progress, "align_features", || {
         align_disks(&mut disks, &normalised, &features, params, progress)
     })?;
-    if align_rep.foldovers > 0 {
-        return Err(Error::numerical(
-            "align_features",
-            format!("{} flipped triangles after the planar warp", align_rep.foldovers),
-        ));
-    }
+    stages::reject_warp_foldovers(align_rep.foldovers, "the planar warp")?;
 
     let common = stages.run(progress, "common_boundary", || common_boundary(&normalised, &disks))?;
     let chain = stages.run(progress, "metamesh", || correspond(&common, params, progress))?;

@@ -58,12 +58,7 @@ pub(super) fn run(
     let align_rep = stages.run(progress, "align_features", || {
         align_features(&mut spheres, &normalised, &features, params, progress)
     })?;
-    if align_rep.foldovers > 0 {
-        return Err(Error::numerical(
-            "align_features",
-            format!("{} flipped triangles after the warp", align_rep.foldovers),
-        ));
-    }
+    stages::reject_warp_foldovers(align_rep.foldovers, "the warp")?;
 
     let chain = stages.run(progress, "metamesh", || correspond(&normalised, &spheres, params, progress))?;
 

@@ -142,6 +142,18 @@ impl Chain {
 
 /// The part of a `per_input` report row both domains share; `domain_specific` (an object) adds
 /// the parameterisation and whatever else the domain measured for input `k`.
+/// The feature alignment must not fold the parameterisation: a warp that flipped `foldovers`
+/// triangles is a numerical failure of the `align_features` stage (`warp` names which warp).
+pub(super) fn reject_warp_foldovers(foldovers: usize, warp: &str) -> Result<()> {
+    if foldovers > 0 {
+        return Err(Error::numerical(
+            "align_features",
+            format!("{foldovers} flipped triangles after {warp}"),
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn per_input_row(
     inputs: &Triangulated,
     k: usize,
