@@ -551,13 +551,53 @@ fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
     {
         bad.push(format!("curve vertex {worst:.2e} from the output chains"));
     }
-    if r["segments_as_edges"].as_f64() != Some(1.0) {
+    // A segment whose ends lie on two pieces of the template that no edge joins cannot be an
+    // edge chain (the raw suzanne's eyes and head, whose sections the network joins where they
+    // touch): accepted only when the template is in several pieces (counted here) and the report
+    // names every unrealised segment as such (`failed_pieces`; counts against a geometric truth
+    // are in tests/fit_unseen_pieces.rs).
+    let failed = r["retriangulation"]["failed_segments"].as_u64().unwrap_or(0);
+    let pieces = r["retriangulation"]["failed_pieces"].as_u64().unwrap_or(0);
+    let honest = failed > 0 && failed == pieces && edge_pieces(template) > 1;
+    if r["segments_as_edges"].as_f64() != Some(1.0) && !honest {
         bad.push(format!("segments_as_edges {}", r["segments_as_edges"]));
     }
     if r["flipped_faces"].as_u64() != Some(0) {
         bad.push(format!("flipped {}", r["flipped_faces"]));
     }
     bad
+}
+
+/// Pieces of a mesh joined through shared edges, vertices welded by exact position first.
+fn edge_pieces(m: &Mesh) -> usize {
+    let mut id: std::collections::HashMap<[u64; 3], usize> = std::collections::HashMap::new();
+    let vid: Vec<usize> = m
+        .positions
+        .iter()
+        .map(|p| {
+            let n = id.len();
+            *id.entry(p.map(|c| (c + 0.0).to_bits())).or_insert(n)
+        })
+        .collect();
+    let tris = m.faces.triangles();
+    let mut edge_face: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
+    let mut parent: Vec<usize> = (0..tris.len()).collect();
+    fn root(p: &mut [usize], mut a: usize) -> usize {
+        while p[a] != a {
+            p[a] = p[p[a]];
+            a = p[a];
+        }
+        a
+    }
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (vid[t[k] as usize], vid[t[(k + 1) % 3] as usize]);
+            let g = *edge_face.entry((a.min(b), a.max(b))).or_insert(f);
+            let (x, y) = (root(&mut parent, f), root(&mut parent, g));
+            parent[x] = y;
+        }
+    }
+    (0..tris.len()).filter(|&f| root(&mut parent, f) == f).count()
 }
 
 fn main() {
@@ -624,8 +664,11 @@ fn main() {
                         r["retriangulation"]
                     );
                 }
-                let status =
-                    if bad.is_empty() { "ok".to_string() } else { format!("BAD {}", bad.join("; ")) };
+                let status = match (bad.is_empty(), r["retriangulation"]["failed_pieces"].as_u64()) {
+                    (true, Some(n)) if n > 0 => format!("ok ({n} segments between unjoined pieces)"),
+                    (true, _) => "ok".to_string(),
+                    _ => format!("BAD {}", bad.join("; ")),
+                };
                 format!(
                     "{status} | regions {} faces {}→{} edges {} flips {} resid {:.1e} angle {:.1}/{:.1} net {}",
                     r["regions"],

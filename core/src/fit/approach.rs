@@ -84,7 +84,8 @@ pub fn approach(
     // Curves farther from the surface than the limit are an input error the fine stage reports,
     // naming the curve: do not drag the template there first.
     let all: Vec<u32> = (0..net.points.len() as u32).collect();
-    if super::insert::feet(pos, tris, &vf, &net.points, &all)?.iter().any(|f| f.2 > max_distance) {
+    if super::insert::feet_near_vertex(pos, tris, &vf, &net.points, &all)?.iter().any(|f| f.2 > max_distance)
+    {
         return Ok(report);
     }
     let length: f64 =
@@ -93,7 +94,7 @@ pub fn approach(
         progress.check()?;
         let h = length / size as f64;
         let sample = spread_sample(net, h, &is_fixed_point);
-        let feet = super::insert::feet(pos, tris, &vf, &net.points, &sample)?;
+        let feet = super::insert::feet_near_vertex(pos, tris, &vf, &net.points, &sample)?;
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());

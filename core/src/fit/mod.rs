@@ -63,8 +63,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let (Some(template), Some(curve_mesh), None) = (it.next(), it.next(), it.next()) else {
         return Err(Error::params("inputs", "fit takes exactly two meshes: template, curves"));
     };
-    // Vertices in no face are removed first (counted in the report); pairs are renumbered.
-    let (template, renumbered_pairs, unreferenced) = template::drop_unreferenced(template, &params.pairs)?;
+    // Coincident vertices are welded (unwelded seams), then vertices in no face are removed
+    // (both counted in the report); pairs are renumbered.
+    let (mut template, mut weld_pairs) = (template, params.pairs.clone());
+    let welded = template::weld_coincident(&mut template, &mut weld_pairs);
+    let (template, renumbered_pairs, unreferenced) = template::drop_unreferenced(template, &weld_pairs)?;
     let renumbered;
     let params = match renumbered_pairs {
         Some(pairs) => {
@@ -433,6 +436,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Reference-free: adjacent faces folded back onto each other (untangle::fold_stats). Added
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
+    report["template_vertices_welded"] = welded.into();
     report["folds"] = fold_report;
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }

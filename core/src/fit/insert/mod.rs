@@ -300,9 +300,40 @@ impl Inserter {
     }
 }
 
-/// Closest point of each curve point on the template: (face, point, distance). Candidates are the
-/// faces of the nearest template vertex's two-ring (exact for points near a reasonable surface).
+/// Closest point of each curve point on the template: (face, point, distance), exact (a BVH over
+/// the faces). The faces around the nearest template *vertex* are not enough: on a coarse template
+/// or one in pieces, the nearest vertex can belong to another piece that passes close by (raw
+/// suzanne: a curve on the head, 0.05 from an eye whose vertices are nearer than any head vertex,
+/// got its foot on the eye, and its segments could not be made edges). `vf` is unused (the
+/// signature of [`feet_near_vertex`]). One BVH build per call: called once per fit.
 pub(crate) fn feet(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    _vf: &[Vec<u32>],
+    points: &[Point3],
+    which: &[u32],
+) -> Result<Vec<(u32, Point3, f64)>> {
+    if tris.is_empty() {
+        return Err(Error::params("template", "the template has no faces"));
+    }
+    let bvh = crate::spatial::Bvh::new(pos, &crate::mesh::Faces::from_triangles(tris));
+    let mut out = Vec::with_capacity(which.len());
+    let mut hint = 0u32;
+    for &i in which {
+        let p = points[i as usize];
+        let (c, slot) =
+            bvh.closest_hinted(p, hint).ok_or_else(|| Error::Internal("empty template".into()))?;
+        hint = slot;
+        out.push((c.face, c.point, c.dist2.sqrt()));
+    }
+    Ok(out)
+}
+
+/// Closest point of each curve point near the template's nearest vertex: (face, point, distance)
+/// over the faces of that vertex's two-ring. Exact for points near a reasonably fine surface in
+/// one piece, and cheap (no BVH build per call): used by the approach levels ([`super::approach`]),
+/// which only steer the template and run several times. The insertion uses the exact [`feet`].
+pub(crate) fn feet_near_vertex(
     pos: &[Point3],
     tris: &[[u32; 3]],
     vf: &[Vec<u32>],

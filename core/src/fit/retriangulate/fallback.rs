@@ -35,6 +35,9 @@ impl Work<'_> {
                 lock_chain(&mut self.locked, &chain[n0 - 1..]);
             }
             Err(why) => {
+                // A separated segment whose ends no edge path joins at all cannot be a chain.
+                let pieces = why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
+                self.stats.failed_pieces += usize::from(pieces);
                 if self.stats.failed.len() < 20 {
                     self.stats.failed.push(FailedSegment {
                         segment: si,
@@ -43,6 +46,7 @@ impl Work<'_> {
                         stopped_at: from,
                         walk,
                         route: match why {
+                            _ if pieces => "pieces",
                             route::NoRoute::Separated => "separated",
                             route::NoRoute::Budget => "budget",
                         },

@@ -129,6 +129,30 @@ pub(super) fn find(
     Err(NoRoute::Separated)
 }
 
+/// Whether `from` and `to` lie on one piece of the mesh: a face of `to`'s star is reachable from
+/// a face of `from`'s across edges (curve edges included). When not, no chain of edges can join
+/// them: they are on different components of the template, or on the two sides of an unwelded
+/// seam (a crack whose coincident boundary edges are not shared). Visits each face at most once.
+pub(super) fn on_one_piece(mesh: &TriMesh, from: u32, to: u32) -> bool {
+    let mut seen: crate::hash::IntSet<u32> = Default::default();
+    let mut stack: Vec<u32> = mesh.faces_of(from).to_vec();
+    seen.extend(stack.iter().copied());
+    while let Some(f) = stack.pop() {
+        let t = mesh.tris[f as usize];
+        if t.contains(&to) {
+            return true;
+        }
+        for k in 0..3 {
+            if let Some(g) = mesh.across(f, t[k], t[(k + 1) % 3]) {
+                if seen.insert(g) {
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

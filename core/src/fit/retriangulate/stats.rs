@@ -39,6 +39,10 @@ pub struct RetriStats {
     pub fallbacks: Vec<FallbackUse>,
     /// Segments that could not be realised at all.
     pub failed_segments: usize,
+    /// Of those, segments whose ends lie on pieces of the template that no edge joins (different
+    /// components, or the two sides of an unwelded seam): no chain of edges can exist, whatever
+    /// the re-triangulation does. Weld or repair the template to realise them.
+    pub failed_pieces: usize,
     /// Why walks stopped (one count per failed walk piece).
     pub walk_fail_start: usize,
     pub walk_fail_boundary: usize,
@@ -60,9 +64,10 @@ pub struct FailedSegment {
     pub stopped_at: u32,
     /// "start", "boundary", "curve_edge", "lost" or "fill".
     pub walk: &'static str,
-    /// Why the route fallback found no way: "separated" (curve edges realised earlier separate the
-    /// ends on the surface: crossing or tangled input, no chain exists without crossing a curve) or
-    /// "budget" (search limit reached).
+    /// Why the route fallback found no way: "pieces" (the ends are on pieces of the template that
+    /// no edge joins: different components or the two sides of an unwelded seam), "separated"
+    /// (curve edges realised earlier separate the ends on the surface: crossing or tangled input,
+    /// no chain exists without crossing a curve) or "budget" (search limit reached).
     pub route: &'static str,
 }
 
