@@ -149,7 +149,13 @@ impl Rbf {
         if let Err(d) = check_centres(centres) {
             return Err(Error::numerical(stage, format!("degenerate RBF centres: {d:?}")));
         }
-        Self::fit_with_directions(centres, values, kernel, stage, &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+        Self::fit_with_directions(
+            centres,
+            values,
+            kernel,
+            stage,
+            &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        )
     }
 
     /// The field for (nearly) coplanar centres: the polynomial part is affine *in the centres'
