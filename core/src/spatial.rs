@@ -191,15 +191,32 @@ impl Bvh {
         best
     }
 
+    /// Largest distance from any of `points` to the surface (0 for no points or no faces).
+    pub fn max_distance(&self, points: &[Point3]) -> f64 {
+        match self.max_dist2_with(points, || Ok::<(), std::convert::Infallible>(())) {
+            Ok(d2) => d2.sqrt(),
+            Err(never) => match never {},
+        }
+    }
+
     /// Largest squared distance from any of `points` to the surface (0 for no points or no
-    /// faces), polling `progress` between chunks. Within a chunk each query starts from the
-    /// previous answer ([`Bvh::closest_hinted`]): points in mesh order follow their neighbours,
-    /// so the hint prunes most of the tree.
+    /// faces), polling `progress` between chunks of queries.
     pub fn max_distance2(&self, points: &[Point3], progress: &Progress) -> Result<f64> {
+        self.max_dist2_with(points, || progress.check())
+    }
+
+    /// Parallel chunks calling `poll` first. Within a chunk each query starts from the previous
+    /// answer ([`Bvh::closest_hinted`]): points in mesh order follow their neighbours, so the hint
+    /// prunes most of the tree.
+    fn max_dist2_with<E: Send>(
+        &self,
+        points: &[Point3],
+        poll: impl Fn() -> Result<(), E> + Sync,
+    ) -> Result<f64, E> {
         points
             .par_chunks(4096)
             .map(|chunk| {
-                progress.check()?;
+                poll()?;
                 let mut slot = 0;
                 let mut m = 0.0f64;
                 for &p in chunk {
