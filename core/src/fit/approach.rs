@@ -84,8 +84,18 @@ pub fn approach(
     // Curves farther from the surface than the limit are an input error the fine stage reports,
     // naming the curve: do not drag the template there first.
     let all: Vec<u32> = (0..net.points.len() as u32).collect();
-    if super::insert::feet_near_vertex(pos, tris, &vf, &net.points, &all)?.iter().any(|f| f.2 > max_distance)
-    {
+    // Around the nearest vertex's two-ring is cheap and exact on one piece; on a template in
+    // pieces the nearest vertex can be on another piece passing close by (raw suzanne: the eyes
+    // were pulled onto the head's curves, 7 flips), so the exact search is used there.
+    let in_pieces = super::insert::walk::face_components(pos.len(), tris).iter().any(|&c| c != 0);
+    let feet_of = |pos: &[Point3], which: &[u32]| {
+        if in_pieces {
+            super::insert::feet(pos, tris, &vf, &net.points, which)
+        } else {
+            super::insert::feet_near_vertex(pos, tris, &vf, &net.points, which)
+        }
+    };
+    if feet_of(pos, &all)?.iter().any(|f| f.2 > max_distance) {
         return Ok(report);
     }
     let length: f64 =
@@ -94,7 +104,7 @@ pub fn approach(
         progress.check()?;
         let h = length / size as f64;
         let sample = spread_sample(net, h, &is_fixed_point);
-        let feet = super::insert::feet_near_vertex(pos, tris, &vf, &net.points, &sample)?;
+        let feet = feet_of(pos, &sample)?;
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());
