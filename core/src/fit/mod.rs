@@ -33,6 +33,7 @@ pub mod kdtree;
 mod params;
 pub mod partition;
 pub mod rbf;
+pub mod refine;
 pub mod report;
 pub mod retriangulate;
 pub mod smooth;
@@ -54,6 +55,11 @@ pub use rbf::Kernel;
 
 use coarse::coarse_alignment;
 use fine::fine_dispatch;
+
+/// Curve-vertex feet one template face may hold before the refinement splits it ([`refine`]).
+const REFINE_MAX_FEET: u32 = 1;
+/// The refinement's face budget: this many faces per curve vertex, over the template's.
+const REFINE_FACES_PER_CURVE_VERTEX: usize = 8;
 
 /// Runs the whole fit. `inputs` = [template, curves]; the curves mesh carries polylines in
 /// `Mesh::curves` (its faces, if any, are ignored).
@@ -107,6 +113,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
+    // Coarse faces under dense curves are split first, so no face has to hold many curve vertices.
+    let refined = stages.run(progress, "refine", || {
+        let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+        refine::refine_near_curves(&mut pos, &mut tris, &net, REFINE_MAX_FEET, budget, &mut parents, progress)
+    })?;
     let fine = stages.run(progress, "fine", || {
         let clock = std::time::Instant::now();
         let pair_fixed = coarse.pair_fixed(&params.pairs);
@@ -434,6 +445,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
     report["folds"] = fold_report;
+    report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }
 
