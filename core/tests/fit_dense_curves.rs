@@ -28,16 +28,8 @@ fn network(h: f64) -> Mesh {
     let q = [0.0, FRAC_PI_2, PI, 3.0 * FRAC_PI_2];
     // Great circles x = 0 and y = 0 are crossed at t = 0, ±30°, 90°, 180°, 270° (z = 0, z = ±1/2
     // at t = 30° and 150° … on their upper half, 210° and 330° on the lower, and the poles).
-    let meridian = vec![
-        0.0,
-        PI / 6.0,
-        FRAC_PI_2,
-        5.0 * PI / 6.0,
-        PI,
-        7.0 * PI / 6.0,
-        3.0 * FRAC_PI_2,
-        11.0 * PI / 6.0,
-    ];
+    let meridian =
+        vec![0.0, PI / 6.0, FRAC_PI_2, 5.0 * PI / 6.0, PI, 7.0 * PI / 6.0, 3.0 * FRAC_PI_2, 11.0 * PI / 6.0];
     type Circle = (Box<dyn Fn(f64) -> Point3>, f64, Vec<f64>);
     let circles: Vec<Circle> = vec![
         (Box::new(|t: f64| [t.cos(), t.sin(), 0.0]), 1.0, q.to_vec()),
@@ -82,7 +74,8 @@ fn hausdorff_to_unit_sphere(m: &Mesh) -> f64 {
         }
     }
     for s in &icosphere(3, 1.0).positions {
-        let d = tris.iter().map(|t| dist(*s, closest_on_triangle(*s, &corners(t)))).fold(f64::INFINITY, f64::min);
+        let d =
+            tris.iter().map(|t| dist(*s, closest_on_triangle(*s, &corners(t)))).fold(f64::INFINITY, f64::min);
         h = h.max(d);
     }
     h

@@ -1,4 +1,4 @@
-//! Template refinement near dense curves, before the fine stage: every template face that holds
+//! Template refinement near dense curves, after the approach and before the fine fit: every template face that holds
 //! the feet (closest points) of more than `max_feet` curve vertices is split 1→4, with conforming
 //! closure, and the count is made again, until no face holds too many or the budget is spent.
 //!
@@ -15,14 +15,15 @@
 //! The split is red–green: a face with two or more split edges is split 1→4 too (repeated until
 //! stable), so the only partial splits are bisections across one edge, and angles stay those of
 //! the template in the red faces. New vertices are edge midpoints (their parents are recorded for
-//! UVs and template groups); they lie on the template's flat faces, and the approach and fine RBFs
-//! that follow move them with their neighbours.
+//! UVs and template groups); they lie on the approached template's flat faces, and the fine RBF
+//! that follows moves them with their neighbours.
 
 use std::collections::HashMap;
 
 use serde::Serialize;
 
 use crate::error::Result;
+use crate::geometry::dist;
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -31,55 +32,92 @@ use super::curves::CurveNetwork;
 /// What the refinement did (the report's `refine`).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct RefineReport {
-    /// Feet allowed per face (0: refinement off).
+    /// A face holding more feet than this starts the refinement (0: refinement off).
+    pub dense_feet: u32,
+    /// Feet of dense curve vertices a face may hold when the refinement ends.
     pub max_feet_per_face: u32,
+    /// Curve vertices whose foot was in a face holding more than `dense_feet` feet.
+    pub dense_curve_vertices: usize,
     pub rounds: u32,
-    /// Faces that held too many feet, per round (each split 1→4).
+    /// Faces that held too many feet and were longer than the curve spacing there, per round
+    /// (each split 1→4).
     pub over_full_per_round: Vec<usize>,
     /// Template faces split (red 1→4 and green closure bisections), over all rounds.
     pub faces_refined: usize,
     /// Faces the refinement added (output faces − input faces).
     pub faces_added: usize,
     pub vertices_added: usize,
-    /// Largest number of feet in one face before and after.
+    /// Largest number of feet in one face before, and of dense feet in one face after.
     pub feet_per_face_max_before: usize,
     pub feet_per_face_max_after: usize,
-    /// True when the face budget stopped the refinement with faces still over-full.
+    /// True when the face budget or the round cap stopped the refinement with faces still
+    /// over-full.
     pub budget_reached: bool,
+    /// Milliseconds (part of the `fine` stage, after the approach).
+    pub ms: f64,
 }
 
-/// Refines `pos`/`tris` near the curves (see the module doc). `parents` gets one entry per new
-/// vertex, in order. The face budget is `max_faces` in total.
+/// Refines `pos`/`tris` near dense curves (see the module doc): the curve vertices whose feet
+/// share a face with more than `dense_feet` others' are dense, and faces holding more than
+/// `max_feet` dense feet are split until none does. `parents` gets one entry per new vertex, in
+/// order. The face budget is `max_faces` in total.
+#[allow(clippy::too_many_arguments)]
 pub fn refine_near_curves(
     pos: &mut Vec<Point3>,
     tris: &mut Vec<[u32; 3]>,
     net: &CurveNetwork,
+    dense_feet: u32,
     max_feet: u32,
     max_faces: usize,
     parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
 ) -> Result<RefineReport> {
-    let mut report = RefineReport { max_feet_per_face: max_feet, ..Default::default() };
-    if max_feet == 0 || net.points.is_empty() {
+    let max_feet = max_feet.max(1).min(dense_feet.max(1));
+    let mut report = RefineReport { dense_feet, max_feet_per_face: max_feet, ..Default::default() };
+    if dense_feet == 0 || net.points.is_empty() {
         return Ok(report);
     }
     let (f0, v0) = (tris.len(), pos.len());
     let all: Vec<u32> = (0..net.points.len() as u32).collect();
-    for round in 0..MAX_ROUNDS {
+    // Dense curve vertices: those whose foot shares a face with too many others. Only they drive
+    // the refinement, so a template already as fine as its curves is left as it is.
+    let (foot_face, count) = feet_per_face(pos, tris, net, &all)?;
+    report.feet_per_face_max_before = count.iter().copied().max().unwrap_or(0);
+    let dense: Vec<u32> = all
+        .iter()
+        .copied()
+        .filter(|&p| count[foot_face[p as usize] as usize] > dense_feet as usize)
+        .collect();
+    report.dense_curve_vertices = dense.len();
+    if dense.is_empty() {
+        return Ok(report);
+    }
+    let spacing = shortest_segments(net);
+    for round in 0..=MAX_ROUNDS {
         progress.check()?;
-        let count = feet_per_face(pos, tris, net, &all)?;
-        let worst = count.iter().copied().max().unwrap_or(0);
-        if round == 0 {
-            report.feet_per_face_max_before = worst;
+        let (face, count) = feet_per_face(pos, tris, net, &dense)?;
+        report.feet_per_face_max_after = count.iter().copied().max().unwrap_or(0);
+        // A face already shorter than the curve's own spacing is not split again: feet crowded
+        // there come from a curve passing beyond a convex corner or crease of the surface (their
+        // closest points pile up), which no finer face separates.
+        let mut finest = vec![f64::INFINITY; tris.len()];
+        for &p in &dense {
+            let f = face[p as usize] as usize;
+            finest[f] = finest[f].min(spacing[p as usize]);
         }
-        report.feet_per_face_max_after = worst;
-        let over: Vec<u32> = (0..tris.len() as u32).filter(|&f| count[f as usize] > max_feet as usize).collect();
+        let longest = |f: usize| {
+            let t = tris[f];
+            (0..3).map(|k| dist(pos[t[k] as usize], pos[t[(k + 1) % 3] as usize])).fold(0.0, f64::max)
+        };
+        let over: Vec<u32> = (0..tris.len() as u32)
+            .filter(|&f| count[f as usize] > max_feet as usize && longest(f as usize) > finest[f as usize])
+            .collect();
         if over.is_empty() {
             break;
         }
         let red = red_closure(tris, &over);
         // A red face becomes 4, a green one 2: stop before the budget is passed.
-        if tris.len() + 3 * red.len() + 3 * red.len() > max_faces {
+        if round == MAX_ROUNDS || tris.len() + 6 * red.len() > max_faces {
             report.budget_reached = true;
             break;
         }
@@ -96,11 +134,29 @@ pub fn refine_near_curves(
     Ok(report)
 }
 
+/// Shortest curve segment at each curve point.
+fn shortest_segments(net: &CurveNetwork) -> Vec<f64> {
+    let mut spacing = vec![f64::INFINITY; net.points.len()];
+    for s in &net.segments {
+        let l = dist(net.points[s[0] as usize], net.points[s[1] as usize]);
+        for &p in s {
+            spacing[p as usize] = spacing[p as usize].min(l);
+        }
+    }
+    spacing
+}
+
 /// Rounds of 1→4 splits at most: 6 rounds take a face to 4⁶ = 4096 pieces.
 const MAX_ROUNDS: u32 = 6;
 
-/// Number of curve-vertex feet in each face.
-fn feet_per_face(pos: &[Point3], tris: &[[u32; 3]], net: &CurveNetwork, which: &[u32]) -> Result<Vec<usize>> {
+/// The face of each curve point's foot (indexed by curve point; `which` only) and the number of
+/// those feet in each face.
+fn feet_per_face(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    net: &CurveNetwork,
+    which: &[u32],
+) -> Result<(Vec<u32>, Vec<usize>)> {
     let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
     for (f, t) in tris.iter().enumerate() {
         for &v in t {
@@ -109,10 +165,12 @@ fn feet_per_face(pos: &[Point3], tris: &[[u32; 3]], net: &CurveNetwork, which: &
     }
     let feet = super::insert::feet(pos, tris, &vf, &net.points, which)?;
     let mut count = vec![0usize; tris.len()];
-    for (f, _, _) in feet {
+    let mut face = vec![u32::MAX; net.points.len()];
+    for (&p, (f, _, _)) in which.iter().zip(feet) {
         count[f as usize] += 1;
+        face[p as usize] = f;
     }
-    Ok(count)
+    Ok((face, count))
 }
 
 /// The faces to split 1→4: `over` plus every face that would otherwise have two or more split
@@ -180,11 +238,14 @@ mod tests {
         let mut pos = ico.positions.clone();
         let net = dense_circle(400, 0.3);
         let mut parents = Vec::new();
-        let r = refine_near_curves(&mut pos, &mut tris, &net, 2, 100_000, &mut parents, &Progress::new())
+        let r = refine_near_curves(&mut pos, &mut tris, &net, 4, 2, 100_000, &mut parents, &Progress::new())
             .expect("refine");
         // 400 feet on a band of the 80 faces: far more than 2 per face before.
         assert!(r.feet_per_face_max_before > 10, "{r:?}");
-        assert_eq!(r.feet_per_face_max_after, feet_per_face(&pos, &tris, &net, &(0..400).collect::<Vec<_>>()).unwrap().into_iter().max().unwrap());
+        // Every curve vertex of this circle is dense (each face under it holds more than 4).
+        assert_eq!(r.dense_curve_vertices, 400);
+        let after = feet_per_face(&pos, &tris, &net, &(0..400).collect::<Vec<_>>()).unwrap().1;
+        assert_eq!(r.feet_per_face_max_after, after.into_iter().max().unwrap());
         assert!(r.feet_per_face_max_after <= 2, "{r:?}");
         assert!(!r.budget_reached);
         assert_eq!(parents.len(), pos.len() - ico.positions.len());
@@ -217,19 +278,31 @@ mod tests {
         let mut tris = crate::shapes::fan_triangles(&ico.faces);
         let mut pos = ico.positions.clone();
         let net = dense_circle(400, 0.3);
-        let r = refine_near_curves(&mut pos, &mut tris, &net, 1, 150, &mut Vec::new(), &Progress::new())
+        let r = refine_near_curves(&mut pos, &mut tris, &net, 1, 1, 150, &mut Vec::new(), &Progress::new())
             .expect("refine");
         assert!(r.budget_reached);
         assert!(tris.len() <= 150);
     }
 
     #[test]
-    fn off_means_untouched() {
+    fn off_or_sparse_curves_leave_the_template_untouched() {
         let ico = crate::shapes::icosphere(1, 1.0);
-        let mut tris = crate::shapes::fan_triangles(&ico.faces);
-        let mut pos = ico.positions.clone();
-        let r = refine_near_curves(&mut pos, &mut tris, &dense_circle(100, 0.0), 0, 1 << 20, &mut Vec::new(), &Progress::new())
+        for (n, dense_feet) in [(100, 0), (12, 4)] {
+            // 12 points on the equator of an 80-face icosphere: at most 2 per face, none dense.
+            let mut tris = crate::shapes::fan_triangles(&ico.faces);
+            let mut pos = ico.positions.clone();
+            let r = refine_near_curves(
+                &mut pos,
+                &mut tris,
+                &dense_circle(n, 0.0),
+                dense_feet,
+                1,
+                1 << 20,
+                &mut Vec::new(),
+                &Progress::new(),
+            )
             .expect("refine");
-        assert_eq!((r.rounds, tris.len(), pos.len()), (0, 80, 42));
+            assert_eq!((r.rounds, r.dense_curve_vertices, tris.len(), pos.len()), (0, 0, 80, 42));
+        }
     }
 }
