@@ -88,17 +88,7 @@ pub(super) fn coarse_alignment(
         let values: Vec<Point3> =
             fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
         let name = |i: usize| format!("pairs[{i}] (template vertex {})", params.pairs[i].template_vertex);
-        let f = fit_rbf(
-            pos,
-            tris,
-            centres,
-            values,
-            &fixed.iter().map(|x| x.1).collect::<Vec<_>>(),
-            params,
-            "coarse",
-            "pairs",
-            &name,
-        )?;
+        let f = fit_rbf(centres, values, params, "coarse", "pairs", &name)?;
         let disp = f.eval_many(pos, progress)?;
         for (p, d) in pos.iter_mut().zip(disp) {
             *p = add(*p, d);
@@ -357,13 +347,9 @@ fn snap_pairs(
 }
 
 /// RBF through the centres with the named-error checks and the coplanar policy.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn fit_rbf(
-    pos: &[Point3],
-    tris: &[[u32; 3]],
-    mut centres: Vec<Point3>,
-    mut values: Vec<Point3>,
-    centre_vertices: &[u32],
+    centres: Vec<Point3>,
+    values: Vec<Point3>,
     params: &FitParams,
     stage: &str,
     field: &str,
@@ -419,46 +405,12 @@ pub(super) fn fit_rbf(
                     ),
                 ));
             }
-            augment(pos, tris, &mut centres, &mut values, centre_vertices);
-            if let Err(d) = rbf::check_centres(&centres) {
-                return Err(Error::params(
-                    field,
-                    format!("{stage} RBF centres stay degenerate after augmentation: {d:?}"),
-                ));
-            }
+            // The seed's remedy was centres offset along the vertex normals; see
+            // [`rbf::Rbf::fit_in_plane`] for why the in-plane polynomial replaces it.
+            return rbf::Rbf::fit_in_plane(&centres, &values, params.kernel, stage).map_err(|e| {
+                Error::params(field, format!("{stage} RBF centres are degenerate even in their plane: {e}"))
+            });
         }
     }
     rbf::Rbf::fit(&centres, &values, params.kernel, stage)
-}
-
-/// Adds, for up to 8 spread-out centres, two points offset along the template vertex normal by
-/// ± 10% of the centres' extent, carrying the same displacement (they move rigidly with their base).
-fn augment(
-    pos: &[Point3],
-    tris: &[[u32; 3]],
-    centres: &mut Vec<Point3>,
-    values: &mut Vec<Point3>,
-    centre_vertices: &[u32],
-) {
-    let n = centres.len();
-    let h = 0.1 * Aabb::of(centres).map(|b| b.diagonal()).unwrap_or(1.0);
-    let mut normal = vec![[0.0; 3]; pos.len()];
-    for t in tris {
-        let fnm = crate::geometry::triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-        for &v in t {
-            normal[v as usize] = add(normal[v as usize], fnm);
-        }
-    }
-    let k = n.min(8);
-    for j in 0..k {
-        let i = j * n / k;
-        let nm = crate::geometry::normalize(normal[centre_vertices[i] as usize]);
-        if nm == [0.0; 3] {
-            continue;
-        }
-        for sgn in [1.0, -1.0] {
-            centres.push(add(centres[i], crate::geometry::scale(nm, sgn * h)));
-            values.push(values[i]);
-        }
-    }
 }

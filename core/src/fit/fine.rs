@@ -32,6 +32,8 @@ pub struct FineReport {
     pub faces_added: usize,
     /// Faces still flipped by the last round (goal 0).
     pub flipped_faces: usize,
+    /// The fine centres were coplanar and `coplanar_centres = "augment"` handled them (RBF with
+    /// the in-plane polynomial, [`super::rbf::Rbf::fit_in_plane`]).
     pub augmented: bool,
     /// "insert" or "nearest_vertex".
     pub matching: &'static str,
@@ -153,11 +155,10 @@ fn fine_fit_inserted(
     let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
     let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
     let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
-    let before_aug = centres.len();
     lap(0);
-    let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
+    let f = fit_rbf(centres, values, params, "fine", "curves", &name)?;
     lap(1);
-    let augmented = f.centre_count() > before_aug;
+    let augmented = f.in_plane();
     let disp = f.eval_many(pos, progress)?;
     let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
     for (p, &v) in vop.iter().enumerate() {
@@ -259,9 +260,8 @@ fn fine_fit(
         let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
         let name =
             |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
-        let before_aug = centres.len();
-        let f = fit_rbf(pos, tris, centres, values, &vop, params, "fine", "curves", &name)?;
-        let augmented = f.centre_count() > before_aug;
+        let f = fit_rbf(centres, values, params, "fine", "curves", &name)?;
+        let augmented = f.in_plane();
         let disp = f.eval_many(pos, progress)?;
         let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
         for (p, &v) in vop.iter().enumerate() {

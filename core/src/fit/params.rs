@@ -52,8 +52,9 @@ pub enum CoplanarCentres {
     /// Fail with an error naming the stage.
     #[default]
     Reject,
-    /// Add centres offset along the template's vertex normals that move with their base centre
-    /// (the seed's remedy, §2.2.2).
+    /// Fit the RBF with its polynomial part affine in the centres' plane only (see
+    /// `fit::rbf::Rbf::fit_in_plane`). The name is the seed's (§2.2.2: augment the centres along
+    /// the normals); that remedy fails when the normals lie in the plane, as for a section.
     Augment,
 }
 

@@ -3,13 +3,14 @@
 //! We interpolate *displacements* d_i = v'_i − v_i at the centres v_i with
 //! `s(x) = Σ α_j φ(|x − v_j|) + R x + t` and move every point to `x + s(x)`. With the full affine
 //! block this is the same map as the thesis's position interpolation (the interpolant is linear in
-//! the data and reproduces affine functions), but it stays meaningful for the normal-augmented
-//! centres, which must keep their offset.
+//! the data and reproduces affine functions).
 //!
 //! The system (2.8) has φ(0) = 0 on the diagonal and a 4×4 zero block: it is symmetric
-//! **indefinite** (the thesis's "positive definite" is wrong), so it is solved with partial-pivot
-//! LU, never Cholesky. It is singular for duplicate centres and for fewer than 4 non-coplanar
-//! ones; both are rejected before the solve with a message naming the centres.
+//! **indefinite** (the thesis's "positive definite" is wrong), so it is solved with a pivoted
+//! LBLᵀ, never Cholesky. It is singular for duplicate centres and for fewer than 4 non-coplanar
+//! ones; both are rejected before the solve with a message naming the centres. Coplanar centres
+//! can instead be fitted with the polynomial part restricted to their plane
+//! ([`Rbf::fit_in_plane`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
@@ -53,6 +54,8 @@ pub struct Rbf {
     kernel: Kernel,
     origin: Point3,
     scale: f64,
+    /// The polynomial part is affine in the centres' plane only ([`Rbf::fit_in_plane`]).
+    in_plane: bool,
     cx: Vec<f64>,
     cy: Vec<f64>,
     cz: Vec<f64>,
@@ -95,9 +98,17 @@ pub fn check_centres(centres: &[Point3]) -> std::result::Result<(), Degenerate> 
     Ok(())
 }
 
-/// Principal spreads of a point set relative to the largest: [smallest, middle] (square roots of
-/// covariance eigenvalue ratios). 0 in the first = coplanar, 0 in both = collinear.
-pub fn spread_ratios(points: &[Point3]) -> [f64; 2] {
+/// Unit principal axes of a point set, largest spread first (the last is the normal of the
+/// best-fitting plane).
+pub fn principal_axes(points: &[Point3]) -> [Point3; 3] {
+    let (_, cov) = covariance(points);
+    let (vals, vecs) = sym_eigen(&cov, 3);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| vals[b].total_cmp(&vals[a]));
+    order.map(|k| [vecs[k], vecs[3 + k], vecs[6 + k]])
+}
+
+fn covariance(points: &[Point3]) -> (Point3, Vec<f64>) {
     let n = points.len().max(1) as f64;
     let mut mean = [0.0; 3];
     for c in points {
@@ -114,6 +125,13 @@ pub fn spread_ratios(points: &[Point3]) -> [f64; 2] {
             }
         }
     }
+    (mean, cov)
+}
+
+/// Principal spreads of a point set relative to the largest: [smallest, middle] (square roots of
+/// covariance eigenvalue ratios). 0 in the first = coplanar, 0 in both = collinear.
+pub fn spread_ratios(points: &[Point3]) -> [f64; 2] {
+    let (_, cov) = covariance(points);
     let (mut vals, _) = sym_eigen(&cov, 3);
     vals.sort_by(f64::total_cmp);
     let max = vals[2];
@@ -128,11 +146,55 @@ impl Rbf {
     /// errors. Call [`check_centres`] first for a message that names the offending centres; this
     /// function repeats the check and reports it generically.
     pub fn fit(centres: &[Point3], values: &[Point3], kernel: Kernel, stage: &str) -> Result<Rbf> {
-        if centres.len() != values.len() {
-            return Err(Error::Internal("rbf: centres and values differ in length".into()));
-        }
         if let Err(d) = check_centres(centres) {
             return Err(Error::numerical(stage, format!("degenerate RBF centres: {d:?}")));
+        }
+        Self::fit_with_directions(
+            centres,
+            values,
+            kernel,
+            stage,
+            &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        )
+    }
+
+    /// The field for (nearly) coplanar centres: the polynomial part is affine *in the centres'
+    /// plane* only (basis 1, u, v), so the system is regular for any non-collinear centres and
+    /// nothing is extrapolated across the plane.
+    ///
+    /// Why not the full affine part: along the plane's normal the centres give no information, so
+    /// its normal gradient is set by round-off (exactly coplanar) or by the centres' tiny spread
+    /// off the plane (nearly coplanar: feet of a planar loop on a faceted sphere), and points
+    /// far from the plane (a sphere's poles) move by that gradient × their distance: folds. The
+    /// seed's remedy, centres offset along the vertex normals, fails for the most natural planar
+    /// network, a section of a surface, because there the normals lie *in* the section plane (a
+    /// circle on a sphere's equator: radial normals), so the augmented set stays coplanar. With
+    /// the in-plane basis the field is even about the plane and bounded away from it, and it
+    /// reproduces any displacement that is affine in the plane exactly (the equator of a unit
+    /// sphere sent to a circle of radius r: the sphere becomes the ellipsoid (r, r, 1)).
+    pub fn fit_in_plane(centres: &[Point3], values: &[Point3], kernel: Kernel, stage: &str) -> Result<Rbf> {
+        match check_centres(centres) {
+            Ok(()) | Err(Degenerate::Coplanar(_)) => {}
+            Err(d) => return Err(Error::numerical(stage, format!("degenerate RBF centres: {d:?}"))),
+        }
+        if spread_ratios(centres)[1] < 1e-6 {
+            return Err(Error::numerical(stage, "degenerate RBF centres: all on one line".to_string()));
+        }
+        let [u, v, _] = principal_axes(centres);
+        Self::fit_with_directions(centres, values, kernel, stage, &[u, v])
+    }
+
+    /// Solves the interpolation system with the polynomial part spanned by 1 and the linear
+    /// functions `d · q` for each unit direction `d` (3 axes: the full affine part of eq. 2.6).
+    fn fit_with_directions(
+        centres: &[Point3],
+        values: &[Point3],
+        kernel: Kernel,
+        stage: &str,
+        directions: &[Point3],
+    ) -> Result<Rbf> {
+        if centres.len() != values.len() {
+            return Err(Error::Internal("rbf: centres and values differ in length".into()));
         }
         let n = centres.len();
         let bb = Aabb::of(centres).ok_or_else(|| Error::Internal("rbf: no centres".into()))?;
@@ -142,18 +204,20 @@ impl Rbf {
             .iter()
             .map(|c| [(c[0] - origin[0]) / scale, (c[1] - origin[1]) / scale, (c[2] - origin[2]) / scale])
             .collect();
-        let m = n + 4;
+        let nd = directions.len();
+        let m = n + nd + 1;
         let mut a = Mat::<f64>::zeros(m, m);
         for i in 0..n {
             for j in 0..n {
                 a[(i, j)] = kernel.phi(dist(q[i], q[j]));
             }
-            for k in 0..3 {
-                a[(i, n + k)] = q[i][k];
-                a[(n + k, i)] = q[i][k];
+            for (k, d) in directions.iter().enumerate() {
+                let x = crate::geometry::dot(*d, q[i]);
+                a[(i, n + k)] = x;
+                a[(n + k, i)] = x;
             }
-            a[(i, n + 3)] = 1.0;
-            a[(n + 3, i)] = 1.0;
+            a[(i, n + nd)] = 1.0;
+            a[(n + nd, i)] = 1.0;
         }
         let mut rhs = Mat::<f64>::zeros(m, 3);
         for i in 0..n {
@@ -176,22 +240,34 @@ impl Rbf {
             ));
         }
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
+        // The polynomial part as the rows x, y, z, 1 of a full affine map (Σ_k d_k ⊗ coefficient_k).
         let mut affine = [[0.0; 3]; 4];
-        for (r, row) in affine.iter_mut().enumerate() {
-            for (k, v) in row.iter_mut().enumerate() {
-                *v = x[(n + r, k)];
+        for (k, d) in directions.iter().enumerate() {
+            for r in 0..3 {
+                for c in 0..3 {
+                    affine[r][c] += d[r] * x[(n + k, c)];
+                }
             }
+        }
+        for c in 0..3 {
+            affine[3][c] = x[(n + nd, c)];
         }
         Ok(Rbf {
             kernel,
             origin,
             scale,
+            in_plane: nd < 3,
             cx: q.iter().map(|p| p[0]).collect(),
             cy: q.iter().map(|p| p[1]).collect(),
             cz: q.iter().map(|p| p[2]).collect(),
             w: [col(0), col(1), col(2)],
             affine,
         })
+    }
+
+    /// Whether the polynomial part is restricted to the centres' plane ([`Rbf::fit_in_plane`]).
+    pub fn in_plane(&self) -> bool {
+        self.in_plane
     }
 
     pub fn centre_count(&self) -> usize {
