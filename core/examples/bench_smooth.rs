@@ -117,7 +117,7 @@ fn bench(path: &str, reps: usize, bandwidth: f64) {
         }
         let b: Vec<f64> = x.iter().zip(&o.scale).flat_map(|(p, m)| [p[0] * m, p[1] * m, p[2] * m]).collect();
         let mut sol: Vec<f64> = x.as_flattened().to_vec();
-        pcg(&a, &b, &mut sol, 3, 1e-10, 2000).iterations
+        pcg(&a, &b, &mut sol, 3, 1e-10, 2000, &meshwork_core::Progress::new()).expect("pcg").iterations
     });
     line(name, n, &format!("implicit_cg(assemble+solve3,{it}it)"), ms);
 

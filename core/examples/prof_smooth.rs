@@ -30,7 +30,12 @@ fn main() {
     p("boundary_vertices", best(reps, || st.boundary_vertices()));
     p("mean_edge_length", best(reps, || laplacian::mean_edge_length(&st, x)));
     p("volume_about", best(reps, || metrics::volume_about(x, f, [0.0; 3])));
-    p("metrics::compare", best(reps, || metrics::compare(x, x, f, [0.0; 3], &vec![false; n], true)));
+    p(
+        "metrics::compare",
+        best(reps, || {
+            metrics::compare(x, x, f, [0.0; 3], &vec![false; n], true, &meshwork_core::job::Progress::new())
+        }),
+    );
     p("displacement", best(reps, || metrics::displacement(x, x)));
     p("mesh clone", best(reps, || m.clone()));
     let job = |params: serde_json::Value| {

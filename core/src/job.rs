@@ -66,6 +66,16 @@ impl Progress {
         Ok(())
     }
 
+    /// [`Progress::check`] at every `period`-th index `i` of a loop, nothing otherwise: for loops
+    /// whose single iteration is too cheap to pay a check (choose `period` for a few ms).
+    pub fn check_every(&self, i: usize, period: usize) -> Result<()> {
+        if i % period.max(1) == 0 {
+            self.check()
+        } else {
+            Ok(())
+        }
+    }
+
     /// Enters a new stage (fraction resets to 0) and checks for cancellation.
     pub fn stage(&self, name: &str) -> Result<()> {
         *lock(&self.inner.stage) = name.to_string();
@@ -90,6 +100,35 @@ impl Progress {
         if let Some(l) = lock(&self.inner.listener).as_ref() {
             let (s, f) = self.snapshot();
             l(&s, f);
+        }
+    }
+}
+
+/// Runs `f` on a thread of its own and waits for it, polling `progress` every millisecond: the
+/// job stops within a poll of a cancel even while `f` is a call it cannot interrupt (faer's
+/// sparse Cholesky, ~0.1–1 s on 100k unknowns). On a cancel the call finishes in the background
+/// and its result is dropped (it holds only its own copies of the data).
+pub fn interruptible<T: Send + 'static>(
+    progress: &Progress,
+    f: impl FnOnce() -> T + Send + 'static,
+) -> Result<T> {
+    use std::sync::mpsc::{sync_channel, RecvTimeoutError};
+    progress.check()?;
+    let (tx, rx) = sync_channel(1);
+    std::thread::Builder::new()
+        .name("meshwork-uninterruptible".into())
+        .spawn(move || {
+            // The receiver is gone when the job was cancelled: nothing to hand the result to.
+            let _ = tx.send(f());
+        })
+        .map_err(|e| Error::Internal(format!("cannot start a worker thread: {e}")))?;
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_millis(1)) {
+            Ok(v) => return Ok(v),
+            Err(RecvTimeoutError::Timeout) => progress.check()?,
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(Error::Internal("a worker thread panicked".into()));
+            }
         }
     }
 }

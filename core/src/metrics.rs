@@ -4,7 +4,9 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use crate::error::Result;
 use crate::geometry::{add, corner_angle, cross, dist, dot, norm, sub};
+use crate::job::Progress;
 use crate::laplacian::Operator;
 use crate::mesh::{Faces, Point3};
 
@@ -180,9 +182,10 @@ pub fn compare(
     apex: Point3,
     skip: &[bool],
     curvature: bool,
-) -> Comparison {
+    progress: &Progress,
+) -> Result<Comparison> {
     let Some(tris) = faces.as_triangles() else {
-        return compare_reference(before, after, faces, apex, skip, curvature);
+        return compare_reference(before, after, faces, apex, skip, curvature, progress);
     };
     let n = before.len();
     let nt = tris.len() / 3;
@@ -195,25 +198,33 @@ pub fn compare(
         .map(|t| {
             let (mut a, mut b) = (TriAcc::new(n, curvature), TriAcc::new(n, curvature));
             let mut flipped = 0;
-            for t in t.chunks_exact(3) {
-                let c0 = a.add(before, t, apex);
-                let c1 = b.add(after, t, apex);
-                flipped += (dot(c0, c1) < 0.0) as usize;
+            // A chunk is a quarter of the mesh or more: poll within it.
+            for block in t.chunks(3 * POLL_TRIANGLES) {
+                progress.check()?;
+                for t in block.chunks_exact(3) {
+                    let c0 = a.add(before, t, apex);
+                    let c1 = b.add(after, t, apex);
+                    flipped += (dot(c0, c1) < 0.0) as usize;
+                }
             }
-            (a, b, flipped)
+            Ok((a, b, flipped))
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let mut it = parts.into_iter();
     let Some((mut a, mut b, mut flipped)) = it.next() else {
-        return Comparison::default();
+        return Ok(Comparison::default());
     };
     for (pa, pb, f) in it {
         a.merge(pa);
         b.merge(pb);
         flipped += f;
     }
-    Comparison { before: a.finish(nt, skip), after: b.finish(nt, skip), flipped_faces: flipped }
+    progress.check()?;
+    Ok(Comparison { before: a.finish(nt, skip), after: b.finish(nt, skip), flipped_faces: flipped })
 }
+
+/// Triangles [`compare`] measures between two polls of `progress.check()` (~1 ms).
+const POLL_TRIANGLES: usize = 8192;
 
 fn compare_reference(
     before: &[Point3],
@@ -222,12 +233,10 @@ fn compare_reference(
     apex: Point3,
     skip: &[bool],
     curvature: bool,
-) -> Comparison {
-    let state = |x: &[Point3]| SurfaceQuality {
-        area: area(x, faces),
-        volume: volume_about(x, faces, apex),
-        angles: angle_stats(x, faces),
-        mean_curvature: curvature.then(|| {
+    progress: &Progress,
+) -> Result<Comparison> {
+    let curvature_of = |x: &[Point3]| -> Option<f64> {
+        curvature.then(|| {
             crate::laplacian::operator(
                 x,
                 faces,
@@ -236,10 +245,21 @@ fn compare_reference(
             )
             .map(|op| mean_curvature(&op, x, skip))
             .unwrap_or(f64::NAN)
-        }),
+        })
+    };
+    // One parallel pass per measure (each a few ms on 100k polygons): poll between them.
+    let state = |x: &[Point3]| -> Result<SurfaceQuality> {
+        let area = area(x, faces);
+        progress.check()?;
+        let volume = volume_about(x, faces, apex);
+        progress.check()?;
+        let angles = angle_stats(x, faces);
+        progress.check()?;
+        Ok(SurfaceQuality { area, volume, angles, mean_curvature: curvature_of(x) })
     };
     let (b, a) = rayon::join(|| state(before), || state(after));
-    Comparison { before: b, after: a, flipped_faces: flipped_faces(before, after, faces) }
+    let (b, a) = (b?, a?);
+    Ok(Comparison { before: b, after: a, flipped_faces: flipped_faces(before, after, faces) })
 }
 
 /// `atan(x)` for `x ≥ 0` (Cephes `atan`: range reduction to |x| ≤ 0.66 and a 4/5 rational
@@ -456,7 +476,9 @@ mod tests {
                 p[0] = -p[0];
             }
             let skip = vec![false; g.vertex_count()];
-            let q = compare(&g.positions, &mirrored, &g.faces, [0.0, 0.0, 1.0], &skip, true);
+            let q =
+                compare(&g.positions, &mirrored, &g.faces, [0.0, 0.0, 1.0], &skip, true, &Progress::new())
+                    .unwrap();
             for s in [q.before, q.after] {
                 assert!((s.area - 9.0).abs() < 1e-12, "{s:?}");
                 assert!((s.volume.abs() - 3.0).abs() < 1e-12, "cone of height 1 over area 9: {s:?}");
@@ -476,7 +498,8 @@ mod tests {
                 .unwrap();
         let boundary = st.boundary_vertices();
         assert_eq!(boundary.iter().filter(|b| **b).count(), 20, "the 6×6 sheet's rim");
-        let q = compare(&g.positions, &g.positions, &g.faces, [0.0; 3], &boundary, true);
+        let q = compare(&g.positions, &g.positions, &g.faces, [0.0; 3], &boundary, true, &Progress::new())
+            .unwrap();
         assert!(q.before.mean_curvature.unwrap().abs() < 1e-12, "{q:?}");
         assert!((q.before.angles.min - 60.0).abs() < 1e-12 && (q.before.angles.max - 60.0).abs() < 1e-12);
         assert_eq!(q.flipped_faces, 0);
@@ -497,9 +520,9 @@ mod tests {
         let mut skip = vec![false; x0.len()];
         skip[3] = true;
         let apex = [0.3, -0.2, 0.1];
-        let q = compare(&x0, &x1, &m.faces, apex, &skip, true);
+        let q = compare(&x0, &x1, &m.faces, apex, &skip, true, &Progress::new()).unwrap();
         // Without curvature: the same triangle measures, no curvature.
-        let lean = compare(&x0, &x1, &m.faces, apex, &skip, false);
+        let lean = compare(&x0, &x1, &m.faces, apex, &skip, false, &Progress::new()).unwrap();
         assert_eq!((lean.before.mean_curvature, lean.after.mean_curvature), (None, None));
         assert_eq!((lean.before.area, lean.after.volume), (q.before.area, q.after.volume));
         assert_eq!((lean.before.angles, lean.flipped_faces), (q.before.angles, q.flipped_faces));
@@ -523,7 +546,7 @@ mod tests {
         let mut f = Faces::new();
         f.push(&[0, 1, 2], 0);
         f.push(&[0, 1, 3], 0);
-        let q = compare(&p, &p, &f, [0.0; 3], &[false; 4], true);
+        let q = compare(&p, &p, &f, [0.0; 3], &[false; 4], true, &Progress::new()).unwrap();
         let a = angle_stats(&p, &f);
         assert_eq!((q.before.angles.min, q.before.angles.max), (0.0, 180.0));
         assert!(close(q.before.angles.mean_min, a.mean_min) && a.min == 0.0 && a.max == 180.0);

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::job::Progress;
 use crate::laplacian::Csr;
 
 /// Which linear solver an implicit step uses.
@@ -118,16 +119,35 @@ pub struct CgInfo {
 
 /// Jacobi-preconditioned CG on `k` ≤ 4 interleaved columns (x[i*k + c]); `x` holds the initial
 /// guess and receives the solution. Stops when every column's ‖r‖ ≤ tol·‖b‖ or after `max_iter`.
-pub fn pcg(a: &Csr, b: &[f64], x: &mut [f64], k: usize, tol: f64, max_iter: usize) -> CgInfo {
-    assert!(b.len() == a.n * k && x.len() == a.n * k, "pcg: sizes");
+/// Polls `progress` every [`CG_POLL_ITERATIONS`] iterations.
+pub fn pcg(
+    a: &Csr,
+    b: &[f64],
+    x: &mut [f64],
+    k: usize,
+    tol: f64,
+    max_iter: usize,
+    progress: &Progress,
+) -> Result<CgInfo> {
+    if b.len() != a.n * k || x.len() != a.n * k {
+        return Err(Error::Internal(format!(
+            "pcg: {} rows × {k} columns, but b has {} and x {} values",
+            a.n,
+            b.len(),
+            x.len()
+        )));
+    }
     match k {
-        1 => pcg_k::<1>(a, b, x, tol, max_iter),
-        2 => pcg_k::<2>(a, b, x, tol, max_iter),
-        3 => pcg_k::<3>(a, b, x, tol, max_iter),
-        4 => pcg_k::<4>(a, b, x, tol, max_iter),
-        _ => panic!("pcg supports 1 to 4 interleaved columns"),
+        1 => pcg_k::<1>(a, b, x, tol, max_iter, progress),
+        2 => pcg_k::<2>(a, b, x, tol, max_iter, progress),
+        3 => pcg_k::<3>(a, b, x, tol, max_iter, progress),
+        4 => pcg_k::<4>(a, b, x, tol, max_iter, progress),
+        _ => Err(Error::Internal(format!("pcg supports 1 to 4 interleaved columns, not {k}"))),
     }
 }
+
+/// CG iterations between two polls of `progress.check()` (~1 ms each on 100k rows).
+const CG_POLL_ITERATIONS: usize = 8;
 
 /// Below this many rows CG runs on the calling thread: a 35k-vertex solve is ~1 ms per
 /// iteration, where three fork-joins per iteration cost more than they save on a busy machine.
@@ -184,7 +204,14 @@ where
 
 /// CG with the vector updates and dot products fused into three row passes per iteration
 /// (A·p with p·Ap; x, r, z with r·r and r·z; p), in fixed-size column arrays.
-fn pcg_k<const K: usize>(a: &Csr, b: &[f64], x: &mut [f64], tol: f64, max_iter: usize) -> CgInfo {
+fn pcg_k<const K: usize>(
+    a: &Csr,
+    b: &[f64],
+    x: &mut [f64],
+    tol: f64,
+    max_iter: usize,
+    progress: &Progress,
+) -> Result<CgInfo> {
     let n = a.n;
     let par = n >= CG_PAR_ROWS;
     let inv_diag: Vec<f64> = a.diagonal().iter().map(|&d| if d > 0.0 { 1.0 / d } else { 1.0 }).collect();
@@ -234,6 +261,7 @@ fn pcg_k<const K: usize>(a: &Csr, b: &[f64], x: &mut [f64], tol: f64, max_iter: 
         if it == max_iter {
             break;
         }
+        progress.check_every(it, CG_POLL_ITERATIONS)?;
         // Ap and p·Ap.
         let ps: &[f64] = &p;
         let (pap, _) = row_pass1::<K, _>(par, &mut ap, |i, ap| {
@@ -275,7 +303,7 @@ fn pcg_k<const K: usize>(a: &Csr, b: &[f64], x: &mut [f64], tol: f64, max_iter: 
             ([0.0; K], [0.0; K])
         });
     }
-    info
+    Ok(info)
 }
 
 /// Elimination of pinned unknowns from a symmetric system.
@@ -424,11 +452,11 @@ mod tests {
         let x2 = from_column_major(&y, 3);
         assert!(x1.iter().zip(&x2).all(|(p, q)| (p - 2.0 * q).abs() < 1e-10));
         let mut x3 = vec![0.0; n * 3];
-        let info = pcg(&a, &b, &mut x3, 3, 1e-12, 500);
+        let info = pcg(&a, &b, &mut x3, 3, 1e-12, 500, &Progress::new()).unwrap();
         assert!(info.converged, "{info:?}");
         assert!(x1.iter().zip(&x3).all(|(p, q)| (p - q).abs() < 1e-9));
         // Warm start at the solution: zero iterations.
-        let info = pcg(&a, &b, &mut x3, 3, 1e-9, 500);
+        let info = pcg(&a, &b, &mut x3, 3, 1e-9, 500, &Progress::new()).unwrap();
         assert_eq!(info.iterations, 0);
     }
 

@@ -6,7 +6,9 @@
 
 use rayon::prelude::*;
 
+use crate::error::Result;
 use crate::geometry::{add, dot, scale, sub};
+use crate::job::Progress;
 use crate::mesh::{Faces, Point3};
 
 /// A hit: closest point, the input face it lies on, squared distance.
@@ -35,8 +37,28 @@ pub struct Bvh {
 
 const LEAF: usize = 4;
 
+/// Work (triangles sorted or queried) between two polls of `progress.check()`: a few ms.
+const POLL_WORK: usize = 1 << 15;
+
 impl Bvh {
     pub fn new(positions: &[Point3], faces: &Faces) -> Bvh {
+        match Self::build(positions, faces, || Ok::<(), std::convert::Infallible>(())) {
+            Ok(b) => b,
+            Err(never) => match never {},
+        }
+    }
+
+    /// [`Bvh::new`] polling `progress` while it builds (a 300k-triangle tree takes ~100 ms).
+    pub fn new_polled(positions: &[Point3], faces: &Faces, progress: &Progress) -> Result<Bvh> {
+        Self::build(positions, faces, || progress.check())
+    }
+
+    /// The build, calling `poll` every [`POLL_WORK`] triangles of splitting work.
+    fn build<E>(
+        positions: &[Point3],
+        faces: &Faces,
+        mut poll: impl FnMut() -> Result<(), E>,
+    ) -> Result<Bvh, E> {
         let mut tris = Vec::with_capacity(faces.len());
         let mut face_of = Vec::with_capacity(faces.len());
         for (fi, f) in faces.iter().enumerate() {
@@ -52,7 +74,13 @@ impl Bvh {
         nodes.push(Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: 0 });
         // Iterative build: (node index, range in `order`).
         let mut stack = vec![(0usize, 0usize, order.len())];
+        let mut work = 0;
         while let Some((ni, lo, hi)) = stack.pop() {
+            work += hi - lo;
+            if work >= POLL_WORK {
+                work = 0;
+                poll()?;
+            }
             let (mut bmin, mut bmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
             let (mut cmin, mut cmax) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
             for &t in &order[lo..hi] {
@@ -97,7 +125,7 @@ impl Bvh {
         }
         let tris_sorted = order.iter().map(|&t| tris[t as usize]).collect();
         let face_sorted = order.iter().map(|&t| face_of[t as usize]).collect();
-        Bvh { nodes, tris: tris_sorted, face_of: face_sorted }
+        Ok(Bvh { nodes, tris: tris_sorted, face_of: face_sorted })
     }
 
     pub fn is_empty(&self) -> bool {
@@ -165,11 +193,41 @@ impl Bvh {
 
     /// Largest distance from any of `points` to the surface (0 for no points or no faces).
     pub fn max_distance(&self, points: &[Point3]) -> f64 {
+        match self.max_dist2_with(points, || Ok::<(), std::convert::Infallible>(())) {
+            Ok(d2) => d2.sqrt(),
+            Err(never) => match never {},
+        }
+    }
+
+    /// Largest squared distance from any of `points` to the surface (0 for no points or no
+    /// faces), polling `progress` between chunks of queries.
+    pub fn max_distance2(&self, points: &[Point3], progress: &Progress) -> Result<f64> {
+        self.max_dist2_with(points, || progress.check())
+    }
+
+    /// Parallel chunks calling `poll` first. Within a chunk each query starts from the previous
+    /// answer ([`Bvh::closest_hinted`]): points in mesh order follow their neighbours, so the hint
+    /// prunes most of the tree.
+    fn max_dist2_with<E: Send>(
+        &self,
+        points: &[Point3],
+        poll: impl Fn() -> Result<(), E> + Sync,
+    ) -> Result<f64, E> {
         points
-            .par_iter()
-            .with_min_len(1024)
-            .map(|&p| self.closest(p).map(|c| c.dist2.sqrt()).unwrap_or(0.0))
-            .reduce(|| 0.0, f64::max)
+            .par_chunks(4096)
+            .map(|chunk| {
+                poll()?;
+                let mut slot = 0;
+                let mut m = 0.0f64;
+                for &p in chunk {
+                    if let Some((h, s)) = self.closest_hinted(p, slot) {
+                        slot = s;
+                        m = m.max(h.dist2);
+                    }
+                }
+                Ok(m)
+            })
+            .try_reduce(|| 0.0, |a, b| Ok(a.max(b)))
     }
 }
 
@@ -243,17 +301,27 @@ pub fn closest_on_triangle(p: Point3, t: &[Point3; 3]) -> Point3 {
 /// max over A's vertices of the distance to surface B and vice versa. (Vertex sampling bounds
 /// the true Hausdorff distance from below; for smoothing, where both surfaces share connectivity,
 /// the two agree closely.) Vertices no face uses are not part of a surface and are skipped.
-pub fn hausdorff_vertices(a: &[Point3], fa: &Faces, b: &[Point3], fb: &Faces) -> f64 {
+pub fn hausdorff_vertices(
+    a: &[Point3],
+    fa: &Faces,
+    b: &[Point3],
+    fb: &Faces,
+    progress: &Progress,
+) -> Result<f64> {
     let used = |x: &[Point3], f: &Faces| -> Vec<Point3> {
         let mut mark = vec![false; x.len()];
         for &v in f.indices() {
-            mark[v as usize] = true;
+            if let Some(m) = mark.get_mut(v as usize) {
+                *m = true;
+            }
         }
         x.iter().zip(&mark).filter(|(_, m)| **m).map(|(p, _)| *p).collect()
     };
-    let (ba, bb) = rayon::join(|| Bvh::new(a, fa), || Bvh::new(b, fb));
-    let (d1, d2) = rayon::join(|| bb.max_distance(&used(a, fa)), || ba.max_distance(&used(b, fb)));
-    d1.max(d2)
+    let (ba, bb) = rayon::join(|| Bvh::new_polled(a, fa, progress), || Bvh::new_polled(b, fb, progress));
+    let (ba, bb) = (ba?, bb?);
+    let (d1, d2) =
+        rayon::join(|| bb.max_distance2(&used(a, fa), progress), || ba.max_distance2(&used(b, fb), progress));
+    Ok(d1?.max(d2?).sqrt())
 }
 
 #[cfg(test)]
@@ -317,9 +385,10 @@ mod tests {
         let a = grid(8, 8, 0.25, false);
         let mut b = a.clone();
         b.positions[40][2] = 0.3; // one interior vertex lifted
-        let h = hausdorff_vertices(&a.positions, &a.faces, &b.positions, &b.faces);
+        let p = Progress::new();
+        let h = hausdorff_vertices(&a.positions, &a.faces, &b.positions, &b.faces, &p).unwrap();
         assert!((h - 0.3).abs() < 1e-15, "{h}");
-        assert_eq!(hausdorff_vertices(&a.positions, &a.faces, &a.positions, &a.faces), 0.0);
+        assert_eq!(hausdorff_vertices(&a.positions, &a.faces, &a.positions, &a.faces, &p).unwrap(), 0.0);
         let _ = norm([0.0; 3]);
     }
 }

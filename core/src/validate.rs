@@ -108,18 +108,51 @@ pub fn run(mesh: &Mesh, params: &ValidateParams, progress: &Progress) -> Result<
     Ok(Output { report: json, ..Default::default() })
 }
 
-/// The report without timings (what repair uses to describe its output).
+/// The report without timings (for tests and benchmarks; jobs use [`analyze_polled`]).
 pub fn analyze(mesh: &Mesh) -> Report {
-    let mut stages = Stages::new();
-    analyze_staged(mesh, 10, &mut stages, &Progress::new())
+    analyze_polled(mesh, &Progress::new())
         .expect("analyze_staged fails only through progress.check(), and a fresh Progress is never cancelled")
 }
 
-/// The report, timing each stage into `stages`.
+/// The report without timings, polling `progress` between its passes but leaving its stage
+/// alone (repair analyses its input and output inside its own stages).
+pub fn analyze_polled(mesh: &Mesh, progress: &Progress) -> Result<Report> {
+    analyze_with(mesh, 10, &mut Timing::Quiet, progress)
+}
+
+/// The report, timing each stage into `stages` (and announcing it on `progress`).
 pub fn analyze_staged(
     mesh: &Mesh,
     max_examples: usize,
     stages: &mut Stages,
+    progress: &Progress,
+) -> Result<Report> {
+    analyze_with(mesh, max_examples, &mut Timing::Stages(stages), progress)
+}
+
+/// Whether the passes of [`analyze_with`] are job stages of their own.
+enum Timing<'a> {
+    Stages(&'a mut Stages),
+    /// Part of a caller's stage: only poll for cancellation between passes.
+    Quiet,
+}
+
+impl Timing<'_> {
+    fn run<T>(&mut self, progress: &Progress, name: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        match self {
+            Timing::Stages(s) => s.run(progress, name, f),
+            Timing::Quiet => {
+                progress.check()?;
+                f()
+            }
+        }
+    }
+}
+
+fn analyze_with(
+    mesh: &Mesh,
+    max_examples: usize,
+    stages: &mut Timing,
     progress: &Progress,
 ) -> Result<Report> {
     let n = mesh.positions.len();

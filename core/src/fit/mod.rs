@@ -24,6 +24,7 @@ mod coarse;
 pub mod compact;
 pub mod correspond;
 pub mod curves;
+pub mod degenerate;
 pub mod ends;
 mod fine;
 pub mod flips;
@@ -298,6 +299,18 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     } else {
         None
     };
+    // Zero-area faces have no normal, so every fold test above passes them: flipped away where
+    // possible, counted in the report otherwise (`degenerate.after`).
+    mesh.pos.clone_from(&out_pos);
+    let degenerate =
+        stages.run(progress, "degenerate", || Ok(degenerate::remove_zero_area(&mut mesh, &curve_edges)))?;
+    if degenerate.flips > 0 {
+        out_tris = mesh.live_triangles();
+        (region, region_count) = partition::regions(&out_tris, &curve_edges);
+        if keep_groups {
+            tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
+        }
+    }
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
     // Vertices removed by the clean-up leave the output; every per-vertex array is renumbered.
@@ -434,6 +447,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
     report["folds"] = fold_report;
+    report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }
 

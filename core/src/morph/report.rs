@@ -2,36 +2,18 @@
 //! reproduce the inputs (symmetric Hausdorff distance, relative to the input's bounding-box
 //! diagonal).
 
+use crate::error::Result;
 use crate::geometry::Aabb;
+use crate::job::Progress;
 use crate::mesh::Faces;
 use crate::mesh::Point3;
 use crate::spatial::Bvh;
 
-/// Max squared distance from `pts` to surface `b`, in parallel chunks; within a chunk each query
-/// starts from the previous answer (the points come in mesh order, so neighbours follow each
-/// other and the hint prunes most of the tree: the overlay has ~10× the inputs' vertices).
-fn max_dist2(pts: &[Point3], b: &Bvh) -> f64 {
-    use rayon::prelude::*;
-    pts.par_chunks(4096)
-        .map(|chunk| {
-            let mut slot = 0;
-            let mut m = 0.0f64;
-            for &p in chunk {
-                if let Some((h, s)) = b.closest_hinted(p, slot) {
-                    slot = s;
-                    m = m.max(h.dist2);
-                }
-            }
-            m
-        })
-        .reduce(|| 0.0, f64::max)
-}
-
 /// One-sided max distance from points (vertices and face centroids of A) to surface B.
-fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &Bvh, centroids: bool) -> f64 {
-    let v = max_dist2(pa, b);
+fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &Bvh, centroids: bool, progress: &Progress) -> Result<f64> {
+    let v = b.max_distance2(pa, progress)?;
     if !centroids {
-        return v.sqrt();
+        return Ok(v.sqrt());
     }
     let c: Vec<Point3> = ta
         .iter()
@@ -40,7 +22,7 @@ fn one_sided(pa: &[Point3], ta: &[[u32; 3]], b: &Bvh, centroids: bool) -> f64 {
             [(x[0] + y[0] + z[0]) / 3.0, (x[1] + y[1] + z[1]) / 3.0, (x[2] + y[2] + z[2]) / 3.0]
         })
         .collect();
-    v.max(max_dist2(&c, b)).sqrt()
+    Ok(v.max(b.max_distance2(&c, progress)?).sqrt())
 }
 
 /// Symmetric Hausdorff distance (sampled at vertices and face centroids) between two triangle
@@ -53,12 +35,16 @@ pub fn relative_hausdorff(
     pb: &[Point3],
     tb: &[[u32; 3]],
     a_centroids: bool,
-) -> f64 {
-    let (ia, ib) =
-        rayon::join(|| Bvh::new(pa, &Faces::from_triangles(ta)), || Bvh::new(pb, &Faces::from_triangles(tb)));
-    let d = one_sided(pa, ta, &ib, a_centroids).max(one_sided(pb, tb, &ia, true));
+    progress: &Progress,
+) -> Result<f64> {
+    let (ia, ib) = rayon::join(
+        || Bvh::new_polled(pa, &Faces::from_triangles(ta), progress),
+        || Bvh::new_polled(pb, &Faces::from_triangles(tb), progress),
+    );
+    let (ia, ib) = (ia?, ib?);
+    let d = one_sided(pa, ta, &ib, a_centroids, progress)?.max(one_sided(pb, tb, &ia, true, progress)?);
     let diag = Aabb::of(pb).map(|b| b.diagonal()).unwrap_or(1.0).max(1e-300);
-    d / diag
+    Ok(d / diag)
 }
 
 /// Largest feature gap (radians on the sphere, units of the unit disk in the plane) above which

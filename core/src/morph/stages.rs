@@ -214,7 +214,7 @@ pub(super) fn finish(
         layer.shapes.iter().map(|s| s.iter().map(|&p| back.apply(p)).collect()).collect();
     let (meshes, artifacts) = output::write_outputs(&mut stages, progress, params, &layer.tris, &shapes_out)?;
     let hausdorff = stages.run(progress, "report", || {
-        Ok((0..k_in)
+        (0..k_in)
             .map(|k| {
                 report::relative_hausdorff(
                     &layer.shapes[k],
@@ -222,9 +222,10 @@ pub(super) fn finish(
                     &f.normalised[k].pos,
                     &f.normalised[k].tris,
                     !f.exact,
+                    progress,
                 )
             })
-            .collect::<Vec<f64>>())
+            .collect::<Result<Vec<f64>>>()
     })?;
     let report = json!({
         "inputs": k_in,

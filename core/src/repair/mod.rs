@@ -186,7 +186,7 @@ pub fn run(mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Out
     params.check()?;
     mesh.check()?;
     let mut stages = Stages::new();
-    let input = stages.run(progress, "validate_input", || Ok(validate::analyze(&mesh)))?;
+    let input = stages.run(progress, "validate_input", || validate::analyze_polled(&mesh, progress))?;
     let mut r = Repairing {
         vmap: VertexMap::identity(mesh.positions.len()),
         mesh,
@@ -201,7 +201,7 @@ pub fn run(mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Out
 
     let out = if r.dirty {
         let mesh = &r.mesh;
-        r.stages.run(progress, "validate_output", || Ok(validate::analyze(mesh)))?
+        r.stages.run(progress, "validate_output", || validate::analyze_polled(mesh, progress))?
     } else {
         input.clone()
     };

@@ -240,7 +240,7 @@ fn boundary_curve_step(ctx: &Ctx, x: &mut [Point3], h: f64) -> Result<()> {
     // zeroing curve entries towards them (they are zero already: only boundary neighbours set).
     let b: Vec<Point3> = x.iter().zip(&d).map(|(p, &d)| scale(*p, d)).collect();
     let mut sys = System::new(a, &moving, SolverChoice::Cholesky, ctx.r.cg_tolerance);
-    sys.solve(&b, x)
+    sys.solve(&b, x, ctx.progress)
 }
 
 fn implicit(ctx: &mut Ctx, x: &mut Vec<Point3>, reassemble: bool) -> Result<()> {
@@ -263,7 +263,7 @@ fn implicit(ctx: &mut Ctx, x: &mut Vec<Point3>, reassemble: bool) -> Result<()> 
             boundary_curve_step(ctx, x, h)?;
         }
         let b: Vec<Point3> = x.iter().zip(&d).map(|(p, &d)| scale(*p, d)).collect();
-        sys.solve(&b, x)?;
+        sys.solve(&b, x, ctx.progress)?;
         ctx.finish_step(x, &before);
     }
     ctx.solver = sys.stats;
@@ -294,7 +294,7 @@ fn inflate(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
             boundary_curve_step(ctx, &mut smooth, h)?;
         }
         let b: Vec<Point3> = x.iter().zip(&d).map(|(p, &d)| scale(*p, d)).collect();
-        sys.solve(&b, &mut smooth)?;
+        sys.solve(&b, &mut smooth, ctx.progress)?;
         let sign = lambda.signum();
         for (p, s) in x.iter_mut().zip(&smooth) {
             *p = add(*p, scale(sub(*s, *p), sign));
@@ -326,7 +326,7 @@ fn fair(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
     let mut sys = System::new(a, &moving, choice, ctx.r.cg_tolerance);
     let b = vec![[0.0; 3]; x.len()];
     let before = x.clone();
-    sys.solve(&b, x).map_err(|e| match e {
+    sys.solve(&b, x, ctx.progress).map_err(|e| match e {
         Error::Numerical { .. } => Error::numerical(
             "fair",
             "the fairing system is singular: the region must not cover a whole component (nothing to hold it)",
@@ -412,20 +412,22 @@ fn tangential(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
         let mut y = vec![0.0; 3 * x.len()];
         op.stiffness.mul_vec(x.as_flattened(), &mut y, 3);
         let normals = super::vertex_normals(x, mesh);
-        let bvh = Bvh::new(x, &mesh.faces);
+        ctx.progress.check()?;
+        let bvh = Bvh::new_polled(x, &mesh.faces, ctx.progress)?;
         let next: Vec<Point3> = (0..x.len())
             .into_par_iter()
             .with_min_len(1024)
             .map(|i| {
+                ctx.progress.check_every(i, 4096)?;
                 if !moving[i] || op.locked[i] {
-                    return x[i];
+                    return Ok(x[i]);
                 }
                 let v = scale([y[3 * i], y[3 * i + 1], y[3 * i + 2]], -h * w[i] / op.scale[i]);
                 let n = normals[i];
                 let t = sub(v, scale(n, dot(v, n)));
-                bvh.closest(add(x[i], t)).map(|c| c.point).unwrap_or(x[i])
+                Ok(bvh.closest(add(x[i], t)).map(|c| c.point).unwrap_or(x[i]))
             })
-            .collect();
+            .collect::<Result<_>>()?;
         *x = next;
         ctx.finish_step(x, &before);
     }
@@ -433,7 +435,7 @@ fn tangential(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
     let st = Stencil::new(&mesh.faces, x.len(), PairLayout::Edges)?;
     let u = st.uniform_stiffness();
     let deg = u.diagonal();
-    let bvh0 = Bvh::new(&mesh.positions, &mesh.faces);
+    let bvh0 = Bvh::new_polled(&mesh.positions, &mesh.faces, ctx.progress)?;
     let lambda = ctx.r.lambda;
     for it in 0..k2 {
         ctx.tick(k1 + it, total)?;
@@ -444,18 +446,19 @@ fn tangential(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
             .into_par_iter()
             .with_min_len(1024)
             .map(|i| {
+                ctx.progress.check_every(i, 4096)?;
                 if !moving[i] || deg[i] <= 0.0 {
-                    return x[i];
+                    return Ok(x[i]);
                 }
                 // Umbrella Δ = mean(neighbours) − x = −(U x)_i / deg_i.
                 let d = scale([y[3 * i], y[3 * i + 1], y[3 * i + 2]], -lambda * w[i] / deg[i]);
-                let Some(c) = bvh0.closest(x[i]) else { return x[i] };
+                let Some(c) = bvh0.closest(x[i]) else { return Ok(x[i]) };
                 let n =
                     normalize(crate::metrics::face_normal(&mesh.positions, mesh.faces.get(c.face as usize)));
                 let t = sub(d, scale(n, dot(d, n)));
-                bvh0.closest(add(x[i], t)).map(|c| c.point).unwrap_or(x[i])
+                Ok(bvh0.closest(add(x[i], t)).map(|c| c.point).unwrap_or(x[i]))
             })
-            .collect();
+            .collect::<Result<_>>()?;
         *x = next;
         ctx.finish_step(x, &before);
     }

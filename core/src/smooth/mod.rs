@@ -113,7 +113,7 @@ pub fn run(mesh: Mesh, params: &SmoothParams, progress: &Progress) -> Result<Out
         })
     })?;
     let x = stages.run(progress, "smooth", || methods::run(&mut ctx))?;
-    let report = stages.run(progress, "metrics", || Ok(report(&ctx, &x)))?;
+    let report = stages.run(progress, "metrics", || report(&ctx, &x))?;
     let mut report = report;
     let obj = report.as_object_mut().ok_or_else(|| Error::Internal("report".into()))?;
     obj.insert("total_ms".into(), json!(stages.total_ms()));
@@ -154,22 +154,25 @@ pub fn vertex_normals(x: &[Point3], mesh: &Mesh) -> Vec<Point3> {
     nr.into_iter().map(crate::geometry::normalize).collect()
 }
 
-fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
+fn report(ctx: &Ctx, x: &[Point3]) -> Result<serde_json::Value> {
     let mesh = ctx.mesh;
     let x0 = &mesh.positions;
     let f = &mesh.faces;
     let (max_d, mean_d) = metrics::displacement(x0, x);
     // One fused pass over the triangles for both states (areas, volume, angles, flips, curvature).
-    let q = metrics::compare(x0, x, f, ctx.center, &ctx.boundary, ctx.r.report_curvature);
+    let q = metrics::compare(x0, x, f, ctx.center, &ctx.boundary, ctx.r.report_curvature, ctx.progress)?;
     let (a0, a1) = (q.before.angles, q.after.angles);
     let vol1 = q.after.volume;
     let (area0, area1) = (q.before.area, q.after.area);
     let (h0, h1) = (q.before.mean_curvature, q.after.mean_curvature);
-    let hausdorff =
-        if ctx.r.hausdorff { Some(crate::spatial::hausdorff_vertices(x0, f, x, f)) } else { None };
+    let hausdorff = if ctx.r.hausdorff {
+        Some(crate::spatial::hausdorff_vertices(x0, f, x, f, ctx.progress)?)
+    } else {
+        None
+    };
     let diag = crate::geometry::Aabb::of(x0).map(|b| b.diagonal()).unwrap_or(0.0);
     let moving = ctx.free.moving.iter().filter(|m| **m).count();
-    json!({
+    Ok(json!({
         "method": ctx.r.method,
         "operator": ctx.r.operator,
         "params": ctx.r,
@@ -203,5 +206,5 @@ fn report(ctx: &Ctx, x: &[Point3]) -> serde_json::Value {
         "mean_curvature_after": h1,
         "solver": ctx.solver,
         "warnings": ctx.warnings,
-    })
+    }))
 }

@@ -7,6 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::error::Result;
+use crate::job::{interruptible, Progress};
 use crate::laplacian::Csr;
 use crate::mesh::Point3;
 use crate::solve::{pcg, Cholesky, Dirichlet, SolverChoice};
@@ -16,6 +17,24 @@ pub const AUTO_CG_MIN_UNKNOWNS: usize = 20_000;
 /// `auto` uses CG when the estimated CG iterations over the whole job stay below this.
 pub const AUTO_CG_MAX_TOTAL_ITERATIONS: f64 = 400.0;
 const CG_MAX_ITER: usize = 2000;
+/// Systems with at least this many unknowns are analysed and factored on a thread of their own
+/// while the job polls for cancellation ([`interruptible`]: faer cannot be interrupted); smaller
+/// ones (a few ms) inline.
+const OFF_THREAD_MIN_UNKNOWNS: usize = 20_000;
+
+/// `f(a)` inline for a small `a`, else on a copy of `a` in [`interruptible`].
+fn off_thread<T: Send + 'static>(
+    progress: &Progress,
+    a: &Csr,
+    f: impl FnOnce(&Csr) -> Result<T> + Send + 'static,
+) -> Result<T> {
+    if a.n < OFF_THREAD_MIN_UNKNOWNS {
+        progress.check()?;
+        return f(a);
+    }
+    let a = a.clone();
+    interruptible(progress, move || f(&a))?
+}
 
 /// What the report says about the solver.
 #[derive(Debug, Clone, Default, Serialize)]
@@ -104,18 +123,26 @@ impl System {
         self.dirty = true;
     }
 
-    fn factor(&mut self) -> Result<()> {
+    fn factor(&mut self, progress: &Progress) -> Result<()> {
         if let Backend::Cholesky(ch) = &mut self.backend {
-            if ch.is_none() {
-                let t = Instant::now();
-                *ch = Some(Cholesky::analyze(&self.dirichlet.reduced)?);
-                self.stats.analyze_ms += t.elapsed().as_secs_f64() * 1e3;
-            }
+            let a = &self.dirichlet.reduced;
+            let c = match ch.take() {
+                Some(c) => c,
+                None => {
+                    let t = Instant::now();
+                    let c = off_thread(progress, a, |a| Cholesky::analyze(a))?;
+                    self.stats.analyze_ms += t.elapsed().as_secs_f64() * 1e3;
+                    c
+                }
+            };
             let t = Instant::now();
-            if let Some(c) = ch.as_mut() {
-                c.factor(&self.dirichlet.reduced)?;
-                self.stats.factor_nnz = c.factor_nnz();
-            }
+            let c = off_thread(progress, a, move |a| {
+                let mut c = c;
+                c.factor(a)?;
+                Ok(c)
+            })?;
+            self.stats.factor_nnz = c.factor_nnz();
+            *ch = Some(c);
             self.stats.factor_ms += t.elapsed().as_secs_f64() * 1e3;
             self.stats.factorizations += 1;
         }
@@ -125,20 +152,21 @@ impl System {
 
     /// Solves for the moving vertices with right-hand side `b` (per vertex, 3 columns); fixed
     /// vertices take their values from `x`, moving ones are overwritten (and warm-start CG).
-    pub fn solve(&mut self, b: &[Point3], x: &mut [Point3]) -> Result<()> {
+    pub fn solve(&mut self, b: &[Point3], x: &mut [Point3], progress: &Progress) -> Result<()> {
         if self.dirichlet.free.is_empty() {
             return Ok(());
         }
         if self.dirty {
-            self.factor()?;
+            self.factor(progress)?;
         }
+        progress.check()?;
         let t = Instant::now();
         let rhs = self.dirichlet.rhs(&self.full, b.as_flattened(), x.as_flattened(), 3);
         let mut y: Vec<f64> = self.dirichlet.free.iter().flat_map(|&i| x[i as usize]).collect();
         let mut fallback = false;
         match &self.backend {
             Backend::Cg => {
-                let info = pcg(&self.dirichlet.reduced, &rhs, &mut y, 3, self.tol, CG_MAX_ITER);
+                let info = pcg(&self.dirichlet.reduced, &rhs, &mut y, 3, self.tol, CG_MAX_ITER, progress)?;
                 self.stats.cg_iterations += info.iterations;
                 self.stats.cg_max_relative_residual =
                     self.stats.cg_max_relative_residual.max(info.relative_residual);
@@ -157,8 +185,8 @@ impl System {
             self.stats.cg_fallbacks += 1;
             self.backend = Backend::Cholesky(None);
             self.stats.kind = "cholesky (after cg fallback)".into();
-            self.factor()?;
-            return self.solve(b, x);
+            self.factor(progress)?;
+            return self.solve(b, x, progress);
         }
         for (f, &i) in self.dirichlet.free.iter().enumerate() {
             x[i as usize] = [y[3 * f], y[3 * f + 1], y[3 * f + 2]];

@@ -231,7 +231,7 @@ pub fn run(mesh: Mesh, p: &SmoothParams, progress: &Progress) -> Result<Output> 
     })?;
     let mut report = stages.run(progress, "metrics", || {
         let measured = Measured { mesh: &mesh, adj: &adj, setup: &setup, before: &before, outcome: &outcome };
-        Ok(job_report(&measured, p, &r, &w, defaults))
+        job_report(&measured, p, &r, &w, defaults, progress)
     })?;
     report["total_ms"] = json!(stages.total_ms());
     report["stages"] = stages.to_json();
@@ -343,10 +343,12 @@ fn job_report(
     r: &super::params::Resolved,
     w: &Weights,
     defaults: Vec<&'static str>,
-) -> serde_json::Value {
+    progress: &Progress,
+) -> Result<serde_json::Value> {
     let (x0, x, f, setup, before) = (&m.mesh.positions, &m.outcome.x, &m.mesh.faces, m.setup, m.before);
     let outcome = m.outcome;
     let after = measure(m.adj, x, setup);
+    progress.check()?;
     let (max_d, _) = metrics::displacement(x0, x);
     let moved: Vec<f64> =
         (0..x.len()).filter(|&v| x[v] != x0[v]).map(|v| crate::geometry::dist(x[v], x0[v])).collect();
@@ -354,7 +356,9 @@ fn job_report(
     let (a0, a1) = (metrics::angle_stats(x0, f), metrics::angle_stats(x, f));
     let center = Aabb::of(x0).map(|b| b.center()).unwrap_or([0.0; 3]);
     let (v0, v1) = (metrics::volume_about(x0, f, center), metrics::volume_about(x, f, center));
-    let hausdorff = r.hausdorff.then(|| crate::spatial::hausdorff_vertices(x0, f, x, f));
+    progress.check()?;
+    let hausdorff =
+        if r.hausdorff { Some(crate::spatial::hausdorff_vertices(x0, f, x, f, progress)?) } else { None };
     let mut rep = json!({
         "method": "highlight",
         "params": {
@@ -409,7 +413,7 @@ fn job_report(
         rep["highlight_lines"] =
             json!({"before": lines_json(&before.model), "after": lines_json(&after.model)});
     }
-    rep
+    Ok(rep)
 }
 
 /// What the user should know about the start state: no highlight line to fair, or vertices the
