@@ -89,23 +89,11 @@ pub fn approach(
     }
     let length: f64 =
         net.segments.iter().map(|s| dist(net.points[s[0] as usize], net.points[s[1] as usize])).sum();
-    // With user pairs, feet follow their curve as in the insertion ([`walked_feet`]). The
-    // automatic alignment's warp is fitted to every curve point and `alignment: none` says the
-    // curves lie on the template: there the closest points are kept (sweep_fit's auto rows are the
-    // same either way; sweep_unseen's teapot-raw, alignment none, lost 0.6 % of its segments).
-    let component = (!fixed.is_empty()).then(|| vertex_components(pos.len(), tris));
-    let mut anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
-    for &(p, _) in fixed {
-        anchor[p as usize] = true;
-    }
     for &size in &sizes {
         progress.check()?;
         let h = length / size as f64;
         let sample = spread_sample(net, h, &is_fixed_point);
-        let feet = match &component {
-            Some(component) => walked_feet(pos, tris, &vf, net, &anchor, component, &sample)?,
-            None => super::insert::feet(pos, tris, &vf, &net.points, &sample)?,
-        };
+        let feet = super::insert::feet(pos, tris, &vf, &net.points, &sample)?;
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());
@@ -145,72 +133,6 @@ pub fn approach(
         report.step.push(step);
     }
     Ok(report)
-}
-
-/// A walked foot farther than this × the closest point's distance is not used (the closest point
-/// is). Measured on bent homer with 12 pairs: the sweep's network needs walked feet up to 2–3×
-/// farther (ratio 2 leaves 18 faces turned over, 3 none); `tests/fit_real.rs`'s network has walks
-/// that went astray (0.049 for a closest 0.006; unguarded they left 179 faces against the truth).
-const WALK_MAX_RATIO: f64 = 3.0;
-
-/// Feet of the `sample` points: closest points, then walked along each curve from its anchors
-/// (feature points, curve ends, user pairs keep their closest points; the others are searched
-/// from the previous foot along the curve, [`super::insert::walk`]). `component`: of each vertex.
-///
-/// Why not plain closest points: with user pairs the coarse RBF is exact only near the pairs, and
-/// elsewhere the surface can be farther from the curves than two of its sheets are from each other:
-/// a sample's closest point then lands on the other sheet, the level
-/// drags that sheet towards the curve, and the distance left for the next level *grows* (bent
-/// homer with 12 pairs: 0.0068 → 0.018, 0.030 at the insertion, 2 flipped faces at the end; with
-/// walked feet 0.016 → 0.011, 0.008 at the insertion and no flipped face).
-fn walked_feet(
-    pos: &[Point3],
-    tris: &[[u32; 3]],
-    vf: &[Vec<u32>],
-    net: &CurveNetwork,
-    anchor: &[bool],
-    component: &[u32],
-    sample: &[u32],
-) -> Result<Vec<(u32, Point3, f64)>> {
-    let all: Vec<u32> = (0..net.points.len() as u32).collect();
-    let closest = super::insert::feet(pos, tris, vf, &net.points, &all)?;
-    let mut feet = closest.clone();
-    super::insert::walk::walk_feet(pos, tris, vf, net, &mut feet, anchor);
-    // A walk cannot leave its component: where the closest point is on another component (a
-    // template made of intersecting parts, e.g. a teapot's body and spout), the curve may really
-    // pass over to it, so the closest point stays. So does it where the walked foot is more than
-    // [`WALK_MAX_RATIO`] times farther: the walk has followed a wrong foot from the previous point.
-    let comp_of = |f: u32| component[tris[f as usize][0] as usize];
-    Ok(sample
-        .iter()
-        .map(|&p| {
-            let (c, w) = (closest[p as usize], feet[p as usize]);
-            if comp_of(c.0) == comp_of(w.0) && w.2 <= WALK_MAX_RATIO * c.2 {
-                w
-            } else {
-                c
-            }
-        })
-        .collect())
-}
-
-/// Connected component (by shared vertices) of every vertex, as a representative vertex id.
-fn vertex_components(nv: usize, tris: &[[u32; 3]]) -> Vec<u32> {
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
-    let mut parent: Vec<u32> = (0..nv as u32).collect();
-    for t in tris {
-        for k in 1..3 {
-            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
-            parent[a as usize] = b;
-        }
-    }
-    (0..nv as u32).map(|v| root(&mut parent, v)).collect()
 }
 
 /// Faces whose normal turns by more than 90° between `before` and `after`.
