@@ -17,7 +17,7 @@ use meshwork_core::geometry::{normalize, Aabb};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Faces, Mesh, Point3};
-use meshwork_core::shapes::{fan_triangles, icosphere};
+use meshwork_core::shapes::{fan_triangles, icosphere, octahedron as octa, tetrahedron as tetra};
 use meshwork_core::spatial::Bvh;
 use serde_json::{json, Value};
 
@@ -85,24 +85,6 @@ fn cube12() -> Mesh {
         tris.push([q[0], q[1], q[2]]);
         tris.push([q[0], q[2], q[3]]);
     }
-    Mesh::from_triangles(pos, &tris)
-}
-
-fn tetra() -> Mesh {
-    let pos = vec![[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
-    Mesh::from_triangles(pos, &[[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
-}
-
-fn octa() -> Mesh {
-    let pos = vec![
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    let tris = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
     Mesh::from_triangles(pos, &tris)
 }
 

@@ -615,7 +615,8 @@ fn main() {
                 }
                 if std::env::var("SWEEP_DETAIL").is_ok() {
                     eprintln!(
-                        "  flips after fine {} / before smoothing {} / final {}; untangle {}; cleanup {}; retriangulation {}",
+                        "  refine {}; flips after fine {} / before smoothing {} / final {}; untangle {}; cleanup {}; retriangulation {}",
+                        r["refine"],
                         r["flipped_faces_after_fine"],
                         r["flipped_faces_before_smoothing"],
                         r["flipped_faces"],

@@ -26,6 +26,9 @@ struct ProgressInner {
     stage: Mutex<String>,
     fraction_bits: AtomicU64,
     listener: Mutex<Option<Listener>>,
+    /// Calls of [`Progress::check`] so far, and the call at which to cancel (0: none).
+    checks: AtomicU64,
+    cancel_at_check: AtomicU64,
 }
 
 type Listener = Box<dyn Fn(&str, f64) + Send + Sync>;
@@ -55,6 +58,10 @@ impl Progress {
 
     /// Err when the job should stop now: cancelled or past its deadline.
     pub fn check(&self) -> Result<()> {
+        let n = self.inner.checks.fetch_add(1, Ordering::Relaxed) + 1;
+        if n == self.inner.cancel_at_check.load(Ordering::Relaxed) {
+            self.cancel();
+        }
         if self.is_cancelled() {
             return Err(Error::Cancelled);
         }
@@ -74,6 +81,18 @@ impl Progress {
         } else {
             Ok(())
         }
+    }
+
+    /// How many times [`Progress::check`] ran (directly or through `stage`/`fraction`): tests
+    /// count the polls inside a stage with it.
+    pub fn checks(&self) -> u64 {
+        self.inner.checks.load(Ordering::Relaxed)
+    }
+
+    /// Cancels at the `n`-th call of [`Progress::check`] (counting from 1), which then fails:
+    /// a deterministic cancel for tests, at any poll of a job.
+    pub fn cancel_at_check(&self, n: u64) {
+        self.inner.cancel_at_check.store(n, Ordering::Relaxed);
     }
 
     /// Enters a new stage (fraction resets to 0) and checks for cancellation.

@@ -187,6 +187,55 @@ pub fn torus(nu: usize, nv: usize, r_major: f64, r_minor: f64, quads: bool) -> M
     Mesh::new(pos, faces)
 }
 
+/// Regular tetrahedron with vertices at alternate corners of the cube [−1, 1]³ (circumradius √3),
+/// outward-oriented.
+pub fn tetrahedron() -> Mesh {
+    let pos = vec![[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
+    Mesh::from_triangles(pos, &[[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+}
+
+/// Regular octahedron with vertices ±eᵢ (on the unit sphere), outward-oriented.
+pub fn octahedron() -> Mesh {
+    let pos = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let tris = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    Mesh::from_triangles(pos, &tris)
+}
+
+/// The upper unit hemisphere by polar rings: a pole fan, `rings` rings of `seg` vertices at
+/// polar angles (π/2)·i/rings, odd rings turned by half a segment; the last ring lies on the
+/// equator and is the boundary. Faces oriented outwards; 1 + rings·seg vertices.
+pub fn hemisphere(rings: usize, seg: usize) -> Mesh {
+    let mut pos = vec![[0.0, 0.0, 1.0]];
+    for i in 1..=rings {
+        let phi = std::f64::consts::FRAC_PI_2 * i as f64 / rings as f64;
+        for j in 0..seg {
+            let th = std::f64::consts::TAU * (j as f64 + 0.5 * (i % 2) as f64) / seg as f64;
+            pos.push([phi.sin() * th.cos(), phi.sin() * th.sin(), phi.cos()]);
+        }
+    }
+    let id = |i: usize, j: usize| (1 + (i - 1) * seg + j % seg) as u32;
+    let mut tris = Vec::new();
+    for j in 0..seg {
+        tris.push([0, id(1, j), id(1, j + 1)]);
+    }
+    for i in 1..rings {
+        for j in 0..seg {
+            let (a, b) = (id(i, j), id(i, j + 1));
+            let (c, d) = (id(i + 1, j), id(i + 1, j + 1));
+            tris.push([a, c, d]);
+            tris.push([a, d, b]);
+        }
+    }
+    Mesh::from_triangles(pos, &tris)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -231,5 +280,24 @@ mod tests {
         assert_eq!(g.positions[4 + 2], [1.0, 0.5, 0.0]);
         let t = triangle_grid(4, 3, 1.0);
         assert_eq!(t.face_count(), 2 * 3 * 2);
+    }
+
+    #[test]
+    fn platonic_solids_and_hemisphere_have_their_volumes_and_counts() {
+        // Tetrahedron in the cube [−1, 1]³: the cube (8) minus four corner pyramids (4/3 each).
+        assert!((signed_volume(&tetrahedron().positions, &tetrahedron().faces) - 8.0 / 3.0).abs() < 1e-12);
+        // Octahedron |x|+|y|+|z| ≤ 1: 4/3, positive (outward).
+        assert!((signed_volume(&octahedron().positions, &octahedron().faces) - 4.0 / 3.0).abs() < 1e-12);
+        let h = hemisphere(10, 24);
+        assert_eq!(h.vertex_count(), 1 + 10 * 24);
+        assert_eq!(h.face_count(), 24 + 2 * 9 * 24);
+        assert!(h.positions.iter().all(|p| (norm(*p) - 1.0).abs() < 1e-12 && p[2] >= -1e-15));
+        // Outward: every face normal points away from the origin.
+        for f in h.faces.iter() {
+            let (a, b, c) =
+                (h.positions[f[0] as usize], h.positions[f[1] as usize], h.positions[f[2] as usize]);
+            let n = crate::geometry::cross(crate::geometry::sub(b, a), crate::geometry::sub(c, a));
+            assert!(crate::geometry::dot(n, a) > 0.0);
+        }
     }
 }

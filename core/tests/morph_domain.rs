@@ -53,31 +53,10 @@ fn dist_to(p: Point3, pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The upper unit hemisphere by polar rings (pole fan, `RINGS` rings of `SEG` vertices, the last
-/// on the equator is the rim), faces oriented outwards.
+/// The upper unit hemisphere of `RINGS` rings of `SEG` vertices (the last on the equator is the
+/// rim), faces oriented outwards.
 fn hemisphere() -> Mesh {
-    let mut pos = vec![[0.0, 0.0, 1.0]];
-    for i in 1..=RINGS {
-        let phi = PI / 2.0 * i as f64 / RINGS as f64;
-        for j in 0..SEG {
-            let th = TAU * (j as f64 + 0.5 * (i % 2) as f64) / SEG as f64;
-            pos.push([phi.sin() * th.cos(), phi.sin() * th.sin(), phi.cos()]);
-        }
-    }
-    let id = |i: usize, j: usize| (1 + (i - 1) * SEG + j % SEG) as u32;
-    let mut tris = Vec::new();
-    for j in 0..SEG {
-        tris.push([0, id(1, j), id(1, j + 1)]);
-    }
-    for i in 1..RINGS {
-        for j in 0..SEG {
-            let (a, b) = (id(i, j), id(i, j + 1));
-            let (c, d) = (id(i + 1, j), id(i + 1, j + 1));
-            tris.push([a, c, d]);
-            tris.push([a, d, b]);
-        }
-    }
-    Mesh::from_triangles(pos, &tris)
+    shapes::hemisphere(RINGS, SEG)
 }
 
 fn centroid(m: &Mesh, t: &[u32; 3]) -> Point3 {

@@ -40,33 +40,6 @@ fn disk(n: usize) -> Mesh {
     m
 }
 
-/// The upper unit hemisphere by polar rings (pole fan, `rings` rings of `seg` vertices, the last
-/// ring on the equator is the boundary); faces oriented outwards.
-fn hemisphere(rings: usize, seg: usize) -> Mesh {
-    let mut pos = vec![[0.0, 0.0, 1.0]];
-    for i in 1..=rings {
-        let phi = std::f64::consts::FRAC_PI_2 * i as f64 / rings as f64;
-        for j in 0..seg {
-            let th = std::f64::consts::TAU * (j as f64 + 0.5 * (i % 2) as f64) / seg as f64;
-            pos.push([phi.sin() * th.cos(), phi.sin() * th.sin(), phi.cos()]);
-        }
-    }
-    let id = |i: usize, j: usize| (1 + (i - 1) * seg + j % seg) as u32;
-    let mut tris = Vec::new();
-    for j in 0..seg {
-        tris.push([0, id(1, j), id(1, j + 1)]);
-    }
-    for i in 1..rings {
-        for j in 0..seg {
-            let (a, b) = (id(i, j), id(i, j + 1));
-            let (c, d) = (id(i + 1, j), id(i + 1, j + 1));
-            tris.push([a, c, d]);
-            tris.push([a, d, b]);
-        }
-    }
-    Mesh::from_triangles(pos, &tris)
-}
-
 /// z = 0.6·(x² + y²) over the disk (a different grid resolution).
 fn paraboloid(n: usize) -> Mesh {
     let mut m = disk(n);
@@ -92,7 +65,8 @@ fn plane_area(plane: &[Point3], tris: &[[u32; 3]]) -> (f64, usize) {
 
 #[test]
 fn elrp_maps_of_the_test_shapes_cover_the_boundary_polygon_once() {
-    for (name, m) in [("hemisphere", hemisphere(10, 24)), ("paraboloid", paraboloid(14)), ("disk", disk(12))]
+    for (name, m) in
+        [("hemisphere", shapes::hemisphere(10, 24)), ("paraboloid", paraboloid(14)), ("disk", disk(12))]
     {
         let (t, _, _) = TriMesh::from_mesh(&m);
         let map = planar::parameterise(&t, PlanarMethod::Elrp).expect("disk map");
@@ -124,7 +98,7 @@ fn elrp_maps_of_the_test_shapes_cover_the_boundary_polygon_once() {
 
 #[test]
 fn disk_to_hemisphere_end_frames_reproduce_both_inputs() {
-    let (a, b) = (disk(16), hemisphere(12, 28));
+    let (a, b) = (disk(16), shapes::hemisphere(12, 28));
     let out = job::run(
         JobKind::Morph,
         vec![a.clone(), b.clone()],
@@ -183,7 +157,7 @@ fn default_registration_and_the_paraboloid() {
 
 #[test]
 fn pseudo_metamesh_reproduces_the_target_and_approximates_the_source() {
-    let (a, b) = (disk(16), hemisphere(12, 28));
+    let (a, b) = (disk(16), shapes::hemisphere(12, 28));
     let run = |c: &str| {
         job::run(
             JobKind::Morph,
@@ -215,7 +189,7 @@ fn pseudo_metamesh_reproduces_the_target_and_approximates_the_source() {
 
 #[test]
 fn feature_pairs_meet_in_the_plane() {
-    let (a, b) = (disk(12), hemisphere(10, 24));
+    let (a, b) = (disk(12), shapes::hemisphere(10, 24));
     // The disk's vertex nearest (0.5, 0, 0) with the hemisphere's nearest (0, 0.6, ·), and the
     // disk's nearest (−0.4, −0.4) with the hemisphere's nearest (0.3, −0.5): a rotation plus a warp.
     let near = |m: &Mesh, x: f64, y: f64| -> u32 {
@@ -391,7 +365,7 @@ fn planar_and_pseudo_glbs_pass_the_khronos_validator() {
     let dir = std::env::temp_dir().join(format!("meshwork-planar-glb-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let cases = [
-        ("planar", vec![disk(8), hemisphere(6, 16)], serde_json::json!({"frames": 6})),
+        ("planar", vec![disk(8), shapes::hemisphere(6, 16)], serde_json::json!({"frames": 6})),
         (
             "sphere-pseudo",
             vec![shapes::icosphere(2, 1.0), shapes::icosphere(1, 1.0)],
@@ -453,7 +427,7 @@ fn sphere_pseudo_metamesh_reports_both_end_frames() {
 
 #[test]
 fn three_disks_chain_through_the_common_rim() {
-    let inputs = vec![disk(10), hemisphere(8, 20), paraboloid(13)];
+    let inputs = vec![disk(10), shapes::hemisphere(8, 20), paraboloid(13)];
     let out = job::run(
         JobKind::Morph,
         inputs.clone(),

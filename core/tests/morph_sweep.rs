@@ -7,27 +7,9 @@ use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::metamesh::{self, Layer};
 use meshwork_core::morph::overlay_degenerate;
-use meshwork_core::shapes::icosphere;
+use meshwork_core::shapes::{icosphere, octahedron as octa, tetrahedron as tetra};
 use meshwork_core::spatial::closest_on_triangle;
 use serde_json::json;
-
-fn tetra() -> Mesh {
-    let pos = vec![[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
-    Mesh::from_triangles(pos, &[[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
-}
-
-fn octa() -> Mesh {
-    let pos = vec![
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    let tris = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
-    Mesh::from_triangles(pos, &tris)
-}
 
 fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     m.faces.iter().map(|f| [f[0], f[1], f[2]]).collect()

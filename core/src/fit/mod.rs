@@ -34,6 +34,7 @@ pub mod kdtree;
 mod params;
 pub mod partition;
 pub mod rbf;
+pub mod refine;
 pub mod report;
 pub mod retriangulate;
 pub mod smooth;
@@ -55,6 +56,9 @@ pub use rbf::Kernel;
 
 use coarse::coarse_alignment;
 use fine::fine_dispatch;
+
+/// The refinement's face budget: this many faces per curve vertex, over the template's.
+const REFINE_FACES_PER_CURVE_VERTEX: usize = 8;
 
 /// Runs the whole fit. `inputs` = [template, curves]; the curves mesh carries polylines in
 /// `Mesh::curves` (its faces, if any, are ignored).
@@ -108,7 +112,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
-    let fine = stages.run(progress, "fine", || {
+    let (fine, refined) = stages.run(progress, "fine", || {
         let clock = std::time::Instant::now();
         let pair_fixed = coarse.pair_fixed(&params.pairs);
         let levels = params.approach_levels as usize;
@@ -116,11 +120,27 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let approach =
             approach::approach(&mut pos, &tris, &net, &pair_fixed, params.kernel, levels, limit, progress)?;
         let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
+        // Faces of the approached template under dense curves are split, so no face has to hold
+        // many curve vertices (after the approach: feet of curves still far from a coarse surface
+        // cluster where it is closest, which is no density of the curves).
+        let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+        let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
+        let mut refined = refine::refine_near_curves(
+            &mut pos,
+            &mut tris,
+            &net,
+            dense,
+            max,
+            budget,
+            &mut parents,
+            progress,
+        )?;
+        refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
         let mut fine =
             fine_dispatch(&mut pos, &mut tris, &net, &coarse, params, template_diag, &mut parents, progress)?;
         fine.report.approach = Some(approach);
         fine.report.approach_ms = approach_ms;
-        Ok(fine)
+        Ok((fine, refined))
     })?;
 
     // Folds the fine deformation left (faces turned against the surface before it) are undone by
@@ -447,6 +467,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
     report["folds"] = fold_report;
+    report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }

@@ -108,6 +108,13 @@ pub struct FitParams {
     pub laplacian_iterations: u32,
     /// Largest number of RBF centres (curve vertices) accepted: the dense solve is O(n³).
     pub max_curve_vertices: u32,
+    /// Before the fine stage, the curve vertices whose closest points (feet) fall in a template
+    /// face with more than this many feet are "dense", and the template is split 1→4 around them
+    /// (repeatedly) so coarse templates can carry dense curves (0 disables; the report's `refine`
+    /// says what was split).
+    pub refine_dense_feet: u32,
+    /// The refinement ends when no face holds more than this many dense feet (≥ 1).
+    pub refine_max_feet: u32,
 }
 
 impl Default for FitParams {
@@ -133,6 +140,8 @@ impl Default for FitParams {
             mcf_step: 0.5,
             laplacian_iterations: 20,
             max_curve_vertices: 8000,
+            refine_dense_feet: 8,
+            refine_max_feet: 1,
         }
     }
 }
@@ -163,6 +172,12 @@ impl FitParams {
         }
         if !(self.cleanup_min_angle_deg.is_finite() && (0.0..=50.0).contains(&self.cleanup_min_angle_deg)) {
             return bad("cleanup_min_angle_deg", "must be in [0, 50]");
+        }
+        if self.refine_dense_feet > 1000 {
+            return bad("refine_dense_feet", "must be ≤ 1000 (0 disables the refinement)");
+        }
+        if self.refine_max_feet == 0 || self.refine_max_feet > self.refine_dense_feet.max(1) {
+            return bad("refine_max_feet", "must be in [1, refine_dense_feet]");
         }
         if self.approach_levels > 6 {
             return bad("approach_levels", "must be ≤ 6");

@@ -55,7 +55,8 @@ pub struct SmoothParams {
     /// Method (default `taubin`).
     pub method: Method,
     /// Number of steps. Defaults: laplacian/taubin 10, implicit 1, mcf 5, inflate 1, tangential 10
-    /// (the Laplacian phase; see `mcf_iterations`). Ignored by `fair` (a single solve).
+    /// (the Laplacian phase; see `mcf_iterations`), highlight 20 (at most; it stops at
+    /// `convergence_threshold`). Ignored by `fair` (a single solve).
     pub iterations: Option<u32>,
     /// Explicit step factor λ (laplacian 0.5, taubin 0.5, tangential 0.5); for `inflate` the
     /// signed λ·dt of eq. 3-8 (default −1: negative inflates, positive smooths).
