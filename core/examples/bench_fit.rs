@@ -389,6 +389,14 @@ fn line(label: &str, s: f64, r: &serde_json::Value) {
         r["min_angle_deg_before_smoothing"].as_f64().unwrap_or(0.0),
         r["min_angle_deg_after_smoothing"].as_f64().unwrap_or(0.0),
     );
+    if std::env::var("FIT_APPROACH").is_ok() {
+        // The approach levels' share of the fine stage and what they did.
+        println!(
+            "  approach {:.1} ms: {}",
+            r["fine"]["approach_ms"].as_f64().unwrap_or(0.0),
+            r["fine"]["approach"]
+        );
+    }
 }
 
 fn main() {

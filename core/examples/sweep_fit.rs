@@ -8,7 +8,8 @@
 //!
 //! Run from the repository root:
 //! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example sweep_fit [NAME…]`
-//! (`SWEEP_FAILED=1` also prints the report's list of segments that could not be made edge chains.)
+//! (`SWEEP_FAILED=1` also prints the report's list of segments that could not be made edge chains;
+//! `SWEEP_APPROACH=1` the fine stage's approach levels and curve distances.)
 
 use std::collections::HashMap;
 use std::time::Instant;
@@ -183,6 +184,15 @@ fn main() {
                     let inside = ends_inside(&out.meshes[0]);
                     if std::env::var("SWEEP_FAILED").is_ok() {
                         eprintln!("{name} {label}: {}", r["retriangulation"]["failed"]);
+                    }
+                    if std::env::var("SWEEP_APPROACH").is_ok() {
+                        eprintln!(
+                            "{name} {label}: approach {} fine distance max {} mean {} insertion {}",
+                            r["fine"]["approach"],
+                            r["fine"]["correspondence_distance_max"],
+                            r["fine"]["correspondence_distance_mean"],
+                            r["fine"]["insertion"]
+                        );
                     }
                     if std::env::var("SWEEP_UNTANGLE").is_ok() {
                         eprintln!(

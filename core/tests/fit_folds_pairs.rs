@@ -1,0 +1,90 @@
+//! Folds with user pairs on a real template: homer (repaired, scaled into the unit box) cut by the
+//! sweep's 4 + 2 planes, the sections thinned and moved by the known bend (`testdata::bend`), the
+//! mesh split once as the template, and 12 pairs at section crossings (the template vertex nearest
+//! the crossing ↔ the bent crossing), as `examples/sweep_fit.rs` does.
+//!
+//! Truths, all independent of the fit: the bent surface the curves were cut from (the output must
+//! stay near it), the orientation of the template (no output face may turn against the normals of
+//! the surface it came from: counted here from the output and the bent truth's closest faces), and
+//! "every segment is a chain".
+//!
+//! KNOWN FAILURE (ignored, a reproduction): today 1 / 2 flipped faces before / after smoothing and
+//! a largest deviation of 1.7 % of the diagonal: the approach levels match curve points to closest
+//! points that jump to a nearby sheet and drag it towards the curves (distance to the curves
+//! 0.0068 → 0.018 → 0.030). Walked feet in the approach made it pass (0 flips, 0.73 %) but were
+//! not kept (DESIGN.md, fit, approach: astray on `fit_real.rs`'s network, 2–3 s on the headline).
+//! Run with `cargo test -p meshwork-core --test fit_folds_pairs -- --ignored`.
+
+use meshwork_core::fit::testdata::{
+    bend, crossing_pairs, plane_sections, sweep_planes, thin_network, to_unit_box,
+};
+use meshwork_core::fit::{run, FitParams};
+use meshwork_core::geometry::{dot, triangle_cross, Aabb};
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::Mesh;
+use meshwork_core::repair::{self, RepairParams};
+use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
+use meshwork_core::spatial::Bvh;
+use meshwork_core::Progress;
+
+fn load(name: &str) -> Mesh {
+    let path = format!("{}/../../shared/meshes/{name}.obj", env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
+    let params = RepairParams { fill_holes: false, ..Default::default() };
+    let mut m = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
+    to_unit_box(&mut m);
+    m
+}
+
+#[test]
+#[ignore = "known failure: approach levels drag a nearby sheet with user pairs (see the file's doc)"]
+fn homer_with_pairs_has_no_flipped_face_and_stays_on_the_bent_surface() {
+    let m = load("homer");
+    let planes = sweep_planes(&m);
+    let sections = thin_network(&plane_sections(&m, &planes), 2);
+    let template = subdivide_midpoint(&m, 1);
+    let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
+    assert_eq!(pairs.len(), 12);
+    let mut curves = sections;
+    for p in &mut curves.positions {
+        *p = bend(*p, 1.0);
+    }
+    let mut truth = template.clone();
+    for p in &mut truth.positions {
+        *p = bend(*p, 1.0);
+    }
+    let params = FitParams { pairs, ..Default::default() };
+    let out = run(vec![template, curves], &params, &Progress::new()).expect("fit");
+    let r = &out.report;
+    let o = &out.meshes[0];
+    assert_eq!(r["segments_as_edges"], 1.0, "{}", r["retriangulation"]["failed"]);
+    // Faces turned over against the truth: each output face's normal vs the normal of the truth
+    // face closest to its centroid.
+    let bvh = Bvh::new(&truth.positions, &truth.faces);
+    let ttris = fan_triangles(&truth.faces);
+    let mut against = 0;
+    for f in o.faces.iter() {
+        let (a, b, c) = (o.positions[f[0] as usize], o.positions[f[1] as usize], o.positions[f[2] as usize]);
+        let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
+        let Some(hit) = bvh.closest(centroid) else { continue };
+        let t = ttris[hit.face as usize];
+        let nt = triangle_cross(
+            truth.positions[t[0] as usize],
+            truth.positions[t[1] as usize],
+            truth.positions[t[2] as usize],
+        );
+        let n = triangle_cross(a, b, c);
+        // Turned over: more than 120° from the truth's normal (steep faces next to a curve spot
+        // can stand at 90–110° to it without being folded).
+        if dot(n, nt) < -0.5 * (dot(n, n) * dot(nt, nt)).sqrt() {
+            against += 1;
+        }
+    }
+    let diag = Aabb::of(&truth.positions).unwrap().diagonal();
+    let dev = bvh.max_distance(&o.positions) / diag;
+    assert_eq!(r["flipped_faces"], 0, "folds {}", r["folds"]);
+    assert_eq!(r["flipped_faces_before_smoothing"], 0);
+    assert_eq!(against, 0, "{against} output faces turned over against the bent truth");
+    assert!(dev < 0.01, "largest distance to the bent truth {dev:.3e} of the diagonal");
+}
