@@ -208,7 +208,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let untangle_retri = stages.run(progress, "untangle_retriangulated", || {
         // (Boundary vertices are never moved by the untangling either.) Folds between fixed
         // vertices may get a free vertex on one of their edges.
-        Ok(untangle::untangle_with_splits(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
+        untangle::untangle_with_splits(
+            &mut mesh,
+            &reference_normals,
+            &realised.on_curve,
+            &curve_edges,
+            8,
+            progress,
+        )
     })?;
     // Vertices those splits added: after the re-triangulation's in every per-vertex array.
     for a in &untangle_retri.added {

@@ -14,7 +14,9 @@
 
 use serde::Serialize;
 
+use crate::error::Result;
 use crate::geometry::{add, dot, scale, sub, triangle_cross};
+use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::trimesh::TriMesh;
@@ -150,14 +152,19 @@ pub fn untangle_with_splits(
     fixed: &[bool],
     locked: &EdgeSet,
     max_passes: usize,
-) -> UntangleStats {
+    progress: &Progress,
+) -> Result<UntangleStats> {
+    progress.check()?;
     let mut stats = untangle(mesh, reference, fixed, locked, max_passes);
     if stats.folded_after == 0 {
-        return stats;
+        return Ok(stats);
     }
     let mut reference = reference[..mesh.pos.len()].to_vec();
     let mut fixed = fixed[..mesh.pos.len()].to_vec();
     for _ in 0..SPLIT_ROUNDS {
+        // Each round clones the mesh and untangles it again: on a 100k-vertex template that is
+        // long enough for a cancel to be noticed between rounds.
+        progress.check()?;
         // A round is kept only when it leaves fewer folds (a split whose ring has no place that
         // sees all its edges, e.g. around crossing fixed curve vertices, only adds faces).
         let snapshot = (mesh.clone(), stats.clone(), reference.len());
@@ -212,7 +219,7 @@ pub fn untangle_with_splits(
             break;
         }
     }
-    stats
+    Ok(stats)
 }
 
 /// Edge flips and ring-mean moves, face by face, until nothing changes; returns the folded count.
