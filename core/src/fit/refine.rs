@@ -92,7 +92,7 @@ pub fn refine_near_curves(
     if dense.is_empty() {
         return Ok(report);
     }
-    let spacing = shortest_segments(net);
+    let spacing = super::insert::shortest_segments(net);
     for round in 0..=MAX_ROUNDS {
         progress.check()?;
         let (face, count) = feet_per_face(pos, tris, net, &dense)?;
@@ -132,18 +132,6 @@ pub fn refine_near_curves(
     report.faces_added = tris.len() - f0;
     report.vertices_added = pos.len() - v0;
     Ok(report)
-}
-
-/// Shortest curve segment at each curve point.
-fn shortest_segments(net: &CurveNetwork) -> Vec<f64> {
-    let mut spacing = vec![f64::INFINITY; net.points.len()];
-    for s in &net.segments {
-        let l = dist(net.points[s[0] as usize], net.points[s[1] as usize]);
-        for &p in s {
-            spacing[p as usize] = spacing[p as usize].min(l);
-        }
-    }
-    spacing
 }
 
 /// Rounds of 1→4 splits at most: 6 rounds take a face to 4⁶ = 4096 pieces.

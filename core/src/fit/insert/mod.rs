@@ -139,8 +139,8 @@ fn vertex_faces(nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
 }
 
 /// Shortest segment at each curve point: a snap may move the point's template vertex by at most
-/// a quarter of it, or dense curves would swap order on the surface.
-fn shortest_segments(net: &CurveNetwork) -> Vec<f64> {
+/// a quarter of it, or dense curves would swap order on the surface (the refinement uses it too).
+pub(super) fn shortest_segments(net: &CurveNetwork) -> Vec<f64> {
     let mut spacing = vec![f64::INFINITY; net.points.len()];
     for s in &net.segments {
         let l = dist(net.points[s[0] as usize], net.points[s[1] as usize]);
