@@ -111,7 +111,7 @@ pub fn run(mesh: &Mesh, params: &ValidateParams, progress: &Progress) -> Result<
 /// The report without timings (for tests and benchmarks; jobs use [`analyze_polled`]).
 pub fn analyze(mesh: &Mesh) -> Report {
     analyze_polled(mesh, &Progress::new())
-        .expect("analyze_staged fails only through progress.check(), and a fresh Progress is never cancelled")
+        .expect("analyze_polled fails only through progress.check(), and a fresh Progress is never cancelled")
 }
 
 /// The report without timings, polling `progress` between its passes but leaving its stage

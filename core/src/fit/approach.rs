@@ -90,7 +90,7 @@ pub fn approach(
     let in_pieces = super::insert::walk::face_components(pos.len(), tris).iter().any(|&c| c != 0);
     let feet_of = |pos: &[Point3], which: &[u32]| {
         if in_pieces {
-            super::insert::feet(pos, tris, &vf, &net.points, which)
+            super::insert::feet(pos, tris, &net.points, which)
         } else {
             super::insert::feet_near_vertex(pos, tris, &vf, &net.points, which)
         }

@@ -145,13 +145,7 @@ fn feet_per_face(
     net: &CurveNetwork,
     which: &[u32],
 ) -> Result<(Vec<u32>, Vec<usize>)> {
-    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
-    for (f, t) in tris.iter().enumerate() {
-        for &v in t {
-            vf[v as usize].push(f as u32);
-        }
-    }
-    let feet = super::insert::feet(pos, tris, &vf, &net.points, which)?;
+    let feet = super::insert::feet(pos, tris, &net.points, which)?;
     let mut count = vec![0usize; tris.len()];
     let mut face = vec![u32::MAX; net.points.len()];
     for (&p, (f, _, _)) in which.iter().zip(feet) {

@@ -84,7 +84,7 @@ pub fn insert_curve_points(
     let n = net.points.len();
     let vf = vertex_faces(pos.len(), tris);
     let all: Vec<u32> = (0..n as u32).collect();
-    let mut feet = feet(pos, tris, &vf, &net.points, &all)?;
+    let mut feet = feet(pos, tris, &net.points, &all)?;
     let on_rim = super::ends::boundary_feet(pos, tris, net, end_snap);
     for b in &on_rim {
         feet[b.point_index as usize] = (b.face, b.foot, b.distance);
@@ -309,7 +309,6 @@ impl Inserter {
 pub(crate) fn feet(
     pos: &[Point3],
     tris: &[[u32; 3]],
-    _vf: &[Vec<u32>],
     points: &[Point3],
     which: &[u32],
 ) -> Result<Vec<(u32, Point3, f64)>> {
@@ -552,8 +551,7 @@ mod tests {
         };
         let net = CurveNetwork::from_mesh(&curves, 1e-9).unwrap();
         // The case this test is for: the bulging points' plain closest points are on the upper sheet.
-        let vf = vertex_faces(pos.len(), &tris);
-        let closest = feet(&pos, &tris, &vf, &pts, &[4, 5]).unwrap();
+        let closest = feet(&pos, &tris, &pts, &[4, 5]).unwrap();
         assert!(closest.iter().all(|f| (f.1[2] - 0.1).abs() < 1e-12));
         let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, &Progress::new()).unwrap();
         assert_eq!(ins.stats.walked_feet, 2);

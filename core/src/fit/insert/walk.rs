@@ -65,25 +65,17 @@ pub fn walk_feet(
 /// Component of each face, numbered from 0 in face order (faces sharing a vertex are connected,
 /// as in the walk): all 0 for a template in one piece.
 pub fn face_components(nv: usize, tris: &[[u32; 3]]) -> Vec<u32> {
+    use crate::topology::{find, union};
     let mut parent: Vec<u32> = (0..nv as u32).collect();
-    fn root(parent: &mut [u32], mut a: u32) -> u32 {
-        while parent[a as usize] != a {
-            parent[a as usize] = parent[parent[a as usize] as usize];
-            a = parent[a as usize];
-        }
-        a
-    }
     for t in tris {
-        for k in 1..3 {
-            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
-            parent[a as usize] = b;
-        }
+        union(&mut parent, t[0], t[1]);
+        union(&mut parent, t[0], t[2]);
     }
     let mut label = vec![u32::MAX; nv];
     let mut next = 0;
     tris.iter()
         .map(|t| {
-            let r = root(&mut parent, t[0]) as usize;
+            let r = find(&mut parent, t[0]) as usize;
             if label[r] == u32::MAX {
                 label[r] = next;
                 next += 1;
