@@ -35,6 +35,9 @@ pub struct ApproachReport {
     /// level moved it (what the level corrects).
     pub distance_max: Vec<f64>,
     pub distance_mean: Vec<f64>,
+    /// Curve points per level whose walked foot was used instead of their closest point (user
+    /// pairs only, [`walked_feet`]).
+    pub walked_feet: Vec<usize>,
 }
 
 /// Sample counts per level: each level uses 4× the centres of the previous one, the last at most
@@ -95,16 +98,35 @@ pub fn approach(
             super::insert::feet_near_vertex(pos, tris, &vf, &net.points, which)
         }
     };
-    if feet_of(pos, &all)?.iter().any(|f| f.2 > max_distance) {
+    let mut unmoved = Some(feet_of(pos, &all)?);
+    if unmoved.iter().flatten().any(|f| f.2 > max_distance) {
         return Ok(report);
     }
     let length: f64 =
         net.segments.iter().map(|s| dist(net.points[s[0] as usize], net.points[s[1] as usize])).sum();
+    // With user pairs, feet follow their curve as in the insertion ([`walked_feet`]); the
+    // automatic alignment's warp is fitted to every curve point, there the closest points are kept.
+    let mut anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
+    for &(p, _) in fixed {
+        anchor[p as usize] = true;
+    }
+    let walk = !fixed.is_empty() && !in_pieces;
     for &size in &sizes {
         progress.check()?;
         let h = length / size as f64;
         let sample = spread_sample(net, h, &is_fixed_point);
-        let feet = feet_of(pos, &sample)?;
+        let feet = if walk {
+            // The first level's surface is the one just measured.
+            let closest = match unmoved.take() {
+                Some(feet) => feet,
+                None => feet_of(pos, &all)?,
+            };
+            let (feet, walked) = walked_feet(pos, tris, &vf, net, &anchor, closest);
+            report.walked_feet.push(walked);
+            sample.iter().map(|&p| feet[p as usize]).collect()
+        } else {
+            feet_of(pos, &sample)?
+        };
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());
@@ -144,6 +166,47 @@ pub fn approach(
         report.step.push(step);
     }
     Ok(report)
+}
+
+/// Every curve point's foot: its closest point, or the foot walked along its curve from the
+/// previous point's ([`super::insert::walk`]; anchors keep their closest points) when the walks
+/// from both sides of the point agree on it. Returns the feet and how many were walked.
+///
+/// Why walked: with user pairs the coarse RBF is exact only near the pairs, and elsewhere the
+/// surface can be farther from the curves than two of its sheets are from each other. A sample's
+/// closest point then lands on the other sheet, the level drags that sheet towards the curve and
+/// the distance left for the next level *grows* (bent homer with 12 pairs: 0.0068 → 0.018, 0.030
+/// at the insertion, 1/2 flipped faces at the end; walked: 0.016 → 0.011, 0.008, none).
+///
+/// Why both sides: a walk that follows a wrong foot goes astray for the rest of its run (on
+/// `tests/fit_real.rs`'s network walked feet 20–400× farther than the closest point, 179 faces
+/// against the truth when used). A point whose nearby sheet is the wrong one is reached from
+/// both of its run's ends on the right sheet, so both walks agree; a walk gone astray from one
+/// end is not followed by the walk from the other end.
+fn walked_feet(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    vf: &[Vec<u32>],
+    net: &CurveNetwork,
+    anchor: &[bool],
+    closest: Vec<(u32, Point3, f64)>,
+) -> (Vec<(u32, Point3, f64)>, usize) {
+    let mut forward = closest.clone();
+    if super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut forward, anchor, false) == 0 {
+        return (forward, 0);
+    }
+    let mut backward = closest.clone();
+    super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut backward, anchor, true);
+    let mut walked = 0;
+    let mut feet = closest;
+    for ((c, f), b) in feet.iter_mut().zip(&forward).zip(&backward) {
+        let agree = dist(f.1, b.1) <= 1e-9 * (1.0 + f.2);
+        if f.0 != c.0 && agree {
+            *c = *f;
+            walked += 1;
+        }
+    }
+    (feet, walked)
 }
 
 /// Faces whose normal turns by more than 90° between `before` and `after`.
