@@ -11,6 +11,11 @@
 use crate::error::Result;
 use crate::job::Progress;
 
+/// Triplets moved between two polls of [`SymCsr::from_triplets_polled`] (a few ms).
+const TRIPLETS_PER_POLL: usize = 1 << 20;
+/// Rows sorted between two polls of [`SymCsr::from_triplets_polled`].
+const ROWS_PER_POLL: usize = 4096;
+
 /// Symmetric sparse matrix, both triangles stored (rows of `(col, value)`).
 #[derive(Debug, Clone, Default)]
 pub struct SymCsr {
@@ -22,26 +27,49 @@ pub struct SymCsr {
 
 impl SymCsr {
     /// Sums duplicate `(i, j, v)` entries; the caller supplies both `(i, j)` and `(j, i)`.
-    pub fn from_triplets(n: usize, mut t: Vec<(u32, u32, f64)>) -> SymCsr {
-        t.sort_unstable_by_key(|e| (e.0, e.1));
-        let mut m = SymCsr { n, ptr: vec![0; n + 1], col: Vec::new(), val: Vec::new() };
-        let mut last: Option<(u32, u32)> = None;
-        for (i, j, v) in t {
-            if last == Some((i, j)) {
-                if let Some(x) = m.val.last_mut() {
-                    *x += v;
-                }
-            } else {
-                m.col.push(j);
-                m.val.push(v);
-                m.ptr[i as usize + 1] += 1;
-                last = Some((i, j));
-            }
+    pub fn from_triplets(n: usize, t: Vec<(u32, u32, f64)>) -> SymCsr {
+        SymCsr::from_triplets_polled(n, t, &Progress::new())
+            .expect("from_triplets_polled fails only through progress.check(), and a fresh Progress is never cancelled")
+    }
+
+    /// [`SymCsr::from_triplets`], polling `progress`. The entries are bucketed by row (a counting
+    /// sort) and each short row is then sorted by column: O(entries) and interruptible, where one
+    /// sort of all entries (millions on a 30k-unknown highlight region) was neither.
+    pub fn from_triplets_polled(n: usize, t: Vec<(u32, u32, f64)>, progress: &Progress) -> Result<SymCsr> {
+        let mut start = vec![0usize; n + 1];
+        for &(i, _, _) in &t {
+            start[i as usize + 1] += 1;
         }
         for i in 0..n {
-            m.ptr[i + 1] += m.ptr[i];
+            start[i + 1] += start[i];
         }
-        m
+        let mut next = start.clone();
+        let mut entries = vec![(0u32, 0.0f64); t.len()];
+        for (k, &(i, j, v)) in t.iter().enumerate() {
+            progress.check_every(k, TRIPLETS_PER_POLL)?;
+            entries[next[i as usize]] = (j, v);
+            next[i as usize] += 1;
+        }
+        drop(t);
+        let mut m = SymCsr { n, ptr: Vec::with_capacity(n + 1), col: Vec::new(), val: Vec::new() };
+        m.ptr.push(0);
+        for i in 0..n {
+            progress.check_every(i, ROWS_PER_POLL)?;
+            let row = &mut entries[start[i]..start[i + 1]];
+            // Stable: duplicates are summed in the order they were supplied.
+            row.sort_by_key(|e| e.0);
+            for &(j, v) in row.iter() {
+                match (m.col.last(), m.val.last_mut()) {
+                    (Some(&last), Some(x)) if m.col.len() > m.ptr[i] && last == j => *x += v,
+                    _ => {
+                        m.col.push(j);
+                        m.val.push(v);
+                    }
+                }
+            }
+            m.ptr.push(m.col.len());
+        }
+        Ok(m)
     }
 
     pub fn mul(&self, x: &[f64], y: &mut [f64]) {
@@ -136,9 +164,9 @@ pub fn solve_box(
     }
     let mut q = objective(h, c, &x, &mut tmp);
     for outer in 0..MAX_OUTER {
-        if outer % 16 == 0 {
-            progress.check()?;
-        }
+        // Each outer iteration costs a few products with H (up to 60 in the line search), each
+        // CG iteration one: at 30k unknowns a product is ~1 ms, so both poll every time.
+        progress.check()?;
         st.outer_iterations = outer + 1;
         let pg = projected_gradient(&g, &x, lo, hi);
         let pgn = pg.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -154,6 +182,7 @@ pub fn solve_box(
         let mut alpha = if dhd > 0.0 { dotv(&d, &d) / dhd } else { 1.0 };
         let mut xn = x.clone();
         for _ in 0..60 {
+            progress.check()?;
             for i in 0..n {
                 xn[i] = x[i] + alpha * d[i];
             }
@@ -179,9 +208,7 @@ pub fn solve_box(
                 break;
             }
             st.cg_iterations += 1;
-            if st.cg_iterations % 256 == 0 {
-                progress.check()?;
-            }
+            progress.check()?;
             h.mul(&p, &mut tmp);
             let php = dotv(&p, &tmp);
             if php <= 0.0 {
