@@ -177,7 +177,7 @@ pub fn fill(mesh: &mut Mesh, opts: &FillOptions, progress: &Progress) -> Result<
             patch.refine(s, &exists, progress)?;
         }
         if opts.fair && patch.pos.len() > n {
-            let res = super::fair::harmonic(&mut patch.pos, n, &patch.tris)?;
+            let res = super::fair::harmonic(&mut patch.pos, n, &patch.tris, progress)?;
             r.fair_max_residual = r.fair_max_residual.max(res);
         }
         // Commit: new vertices, faces, created edges.

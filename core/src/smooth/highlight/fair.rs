@@ -23,8 +23,9 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::lines::{self, Adjacency, Lights, Model};
-use super::qp::{self, QpStats, SymCsr};
+use super::qp::{self, QpStats};
 use super::target::{self, Runs};
+use crate::laplacian::Csr;
 
 /// Halvings tried when a step flips a triangle or does not lower the target.
 pub const MAX_HALVINGS: usize = 6;
@@ -310,7 +311,7 @@ pub fn node_jacobian(
 
 /// The Gauss–Newton QP `min ½xᵀHx + cᵀx` of eq. 15 at the current positions.
 pub struct Quadratic {
-    pub h: SymCsr,
+    pub h: Csr,
     pub c: Vec<f64>,
     pub rows: usize,
 }
@@ -378,14 +379,12 @@ pub fn quadratic(
             }
         }
     }
-    let mut h = SymCsr::from_triplets_polled(n, trip, progress)?;
+    let mut h = Csr::from_triplets_polled(n, trip, progress)?;
     // A vanishing ridge keeps H definite for unknowns no residual sees (a flat, line-free patch).
     let dmax = h.diagonal().iter().fold(0.0f64, |m, v| m.max(*v));
     let ridge = 1e-12 * dmax.max(1e-300);
-    for i in 0..n {
-        if let Some(p) = (h.ptr[i]..h.ptr[i + 1]).find(|&p| h.col[p] as usize == i) {
-            h.val[p] += ridge;
-        }
+    for p in h.diagonal_positions() {
+        h.val[p] += ridge;
     }
     Ok(Quadratic { h, c, rows })
 }

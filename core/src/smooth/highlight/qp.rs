@@ -10,93 +10,7 @@
 
 use crate::error::Result;
 use crate::job::Progress;
-
-/// Triplets moved between two polls of [`SymCsr::from_triplets_polled`] (a few ms).
-const TRIPLETS_PER_POLL: usize = 1 << 20;
-/// Rows sorted between two polls of [`SymCsr::from_triplets_polled`].
-const ROWS_PER_POLL: usize = 4096;
-
-/// Symmetric sparse matrix, both triangles stored (rows of `(col, value)`).
-#[derive(Debug, Clone, Default)]
-pub struct SymCsr {
-    pub n: usize,
-    pub ptr: Vec<usize>,
-    pub col: Vec<u32>,
-    pub val: Vec<f64>,
-}
-
-impl SymCsr {
-    /// Sums duplicate `(i, j, v)` entries; the caller supplies both `(i, j)` and `(j, i)`.
-    pub fn from_triplets(n: usize, t: Vec<(u32, u32, f64)>) -> SymCsr {
-        SymCsr::from_triplets_polled(n, t, &Progress::new())
-            .expect("from_triplets_polled fails only through progress.check(), and a fresh Progress is never cancelled")
-    }
-
-    /// [`SymCsr::from_triplets`], polling `progress`. The entries are bucketed by row (a counting
-    /// sort) and each short row is then sorted by column: O(entries) and interruptible, where one
-    /// sort of all entries (millions on a 30k-unknown highlight region) was neither.
-    pub fn from_triplets_polled(n: usize, t: Vec<(u32, u32, f64)>, progress: &Progress) -> Result<SymCsr> {
-        let mut start = vec![0usize; n + 1];
-        for &(i, _, _) in &t {
-            start[i as usize + 1] += 1;
-        }
-        for i in 0..n {
-            start[i + 1] += start[i];
-        }
-        let mut next = start.clone();
-        let mut entries = vec![(0u32, 0.0f64); t.len()];
-        for (k, &(i, j, v)) in t.iter().enumerate() {
-            progress.check_every(k, TRIPLETS_PER_POLL)?;
-            entries[next[i as usize]] = (j, v);
-            next[i as usize] += 1;
-        }
-        drop(t);
-        let mut m = SymCsr { n, ptr: Vec::with_capacity(n + 1), col: Vec::new(), val: Vec::new() };
-        m.ptr.push(0);
-        for i in 0..n {
-            progress.check_every(i, ROWS_PER_POLL)?;
-            let row = &mut entries[start[i]..start[i + 1]];
-            // Stable: duplicates are summed in the order they were supplied.
-            row.sort_by_key(|e| e.0);
-            for &(j, v) in row.iter() {
-                match (m.col.last(), m.val.last_mut()) {
-                    (Some(&last), Some(x)) if m.col.len() > m.ptr[i] && last == j => *x += v,
-                    _ => {
-                        m.col.push(j);
-                        m.val.push(v);
-                    }
-                }
-            }
-            m.ptr.push(m.col.len());
-        }
-        Ok(m)
-    }
-
-    pub fn mul(&self, x: &[f64], y: &mut [f64]) {
-        for i in 0..self.n {
-            let mut s = 0.0;
-            for p in self.ptr[i]..self.ptr[i + 1] {
-                s += self.val[p] * x[self.col[p] as usize];
-            }
-            y[i] = s;
-        }
-    }
-
-    pub fn nnz(&self) -> usize {
-        self.val.len()
-    }
-
-    pub fn diagonal(&self) -> Vec<f64> {
-        (0..self.n)
-            .map(|i| {
-                (self.ptr[i]..self.ptr[i + 1])
-                    .find(|&p| self.col[p] as usize == i)
-                    .map(|p| self.val[p])
-                    .unwrap_or(0.0)
-            })
-            .collect()
-    }
-}
+use crate::laplacian::Csr;
 
 /// What the solver did.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
@@ -117,8 +31,8 @@ fn dotv(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn objective(h: &SymCsr, c: &[f64], x: &[f64], tmp: &mut [f64]) -> f64 {
-    h.mul(x, tmp);
+fn objective(h: &Csr, c: &[f64], x: &[f64], tmp: &mut [f64]) -> f64 {
+    h.mul_vec(x, tmp, 1);
     0.5 * dotv(x, tmp) + dotv(c, x)
 }
 
@@ -138,7 +52,7 @@ fn project(x: &mut [f64], lo: &[f64], hi: &[f64]) {
 /// Solves the box QP to a relative projected-gradient tolerance `tol`, starting from the point of
 /// the box nearest 0. Needs `lo ≤ hi`.
 pub fn solve_box(
-    h: &SymCsr,
+    h: &Csr,
     c: &[f64],
     lo: &[f64],
     hi: &[f64],
@@ -151,7 +65,7 @@ pub fn solve_box(
     let mut g = vec![0.0; n];
     let mut tmp = vec![0.0; n];
     let grad = |x: &[f64], g: &mut [f64]| {
-        h.mul(x, g);
+        h.mul_vec(x, g, 1);
         for i in 0..n {
             g[i] += c[i];
         }
@@ -177,7 +91,7 @@ pub fn solve_box(
         }
         // 1. Projected gradient step (Armijo along the projection arc).
         let d: Vec<f64> = pg.iter().map(|v| -v).collect();
-        h.mul(&d, &mut tmp);
+        h.mul_vec(&d, &mut tmp, 1);
         let dhd = dotv(&d, &tmp);
         let mut alpha = if dhd > 0.0 { dotv(&d, &d) / dhd } else { 1.0 };
         let mut xn = x.clone();
@@ -209,7 +123,7 @@ pub fn solve_box(
             }
             st.cg_iterations += 1;
             progress.check()?;
-            h.mul(&p, &mut tmp);
+            h.mul_vec(&p, &mut tmp, 1);
             let php = dotv(&p, &tmp);
             if php <= 0.0 {
                 break;
@@ -279,7 +193,7 @@ mod tests {
     }
 
     /// H = Aᵀ A + δI for a random sparse-ish A (always SPD).
-    fn random_problem(n: usize, seed: u64) -> (SymCsr, Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn random_problem(n: usize, seed: u64) -> (Csr, Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut r = rng(seed);
         let mut dense = vec![vec![0.0; n]; n];
         for _ in 0..2 * n {
@@ -303,13 +217,13 @@ mod tests {
         let c = (0..n).map(|_| r() * 4.0).collect();
         let lo = (0..n).map(|_| -0.1 - (r() + 0.5) * 0.5).collect();
         let hi = (0..n).map(|_| 0.1 + (r() + 0.5) * 0.5).collect();
-        (SymCsr::from_triplets(n, t), c, lo, hi)
+        (Csr::from_triplets(n, t), c, lo, hi)
     }
 
     #[test]
     fn diagonal_problem_is_the_clamped_minimiser() {
         // Separable: x_i = clamp(−c_i/h_i, lo_i, hi_i), by hand.
-        let h = SymCsr::from_triplets(3, vec![(0, 0, 2.0), (1, 1, 1.0), (2, 2, 4.0)]);
+        let h = Csr::from_triplets(3, vec![(0, 0, 2.0), (1, 1, 1.0), (2, 2, 4.0)]);
         let c = [-1.0, 3.0, -1.0];
         let (x, st) = solve_box(&h, &c, &[-1.0; 3], &[1.0; 3], 1e-12, &Progress::new()).unwrap();
         assert!(
@@ -328,7 +242,7 @@ mod tests {
             let (x, st) = solve_box(&h, &c, &lo, &hi, 1e-10, &Progress::new()).unwrap();
             assert!(st.converged, "seed {seed}: {st:?}");
             let mut g = vec![0.0; n];
-            h.mul(&x, &mut g);
+            h.mul_vec(&x, &mut g, 1);
             let gmax = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for i in 0..n {
                 g[i] += c[i];
@@ -354,7 +268,7 @@ mod tests {
         let neg: Vec<f64> = big.iter().map(|v| -v).collect();
         let (x, _) = solve_box(&h, &c, &neg, &big, 1e-12, &Progress::new()).unwrap();
         let mut g = vec![0.0; 30];
-        h.mul(&x, &mut g);
+        h.mul_vec(&x, &mut g, 1);
         let res = g.iter().zip(&c).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max);
         assert!(res < 1e-8, "residual {res}");
     }
