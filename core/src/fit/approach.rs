@@ -283,3 +283,103 @@ fn dedup_centres(centres: &mut Vec<Point3>, values: &mut Vec<Point3>) {
         keep[k - 1]
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two parallel unit squares, z = 0 (facing −z) and z = 0.1 (facing +z), 8 × 8 cells each: a
+    /// thin plate whose sheets are closer than the curve may be to either.
+    fn plate() -> (Vec<Point3>, Vec<[u32; 3]>, Vec<Vec<u32>>) {
+        let n = 8;
+        let mut pos = Vec::new();
+        let mut tris = Vec::new();
+        for (sheet, z) in [0.0, 0.1].into_iter().enumerate() {
+            let base = pos.len() as u32;
+            for j in 0..=n {
+                for i in 0..=n {
+                    pos.push([i as f64 / n as f64, j as f64 / n as f64, z]);
+                }
+            }
+            let id = |i: u32, j: u32| base + j * (n + 1) + i;
+            for j in 0..n {
+                for i in 0..n {
+                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                    if sheet == 0 {
+                        tris.extend([[a, c, b], [a, d, c]]);
+                    } else {
+                        tris.extend([[a, b, c], [a, c, d]]);
+                    }
+                }
+            }
+        }
+        let mut vf = vec![Vec::new(); pos.len()];
+        for (f, t) in tris.iter().enumerate() {
+            for &v in t {
+                vf[v as usize].push(f as u32);
+            }
+        }
+        (pos, tris, vf)
+    }
+
+    fn network(pts: &[Point3]) -> CurveNetwork {
+        let curves = crate::mesh::Mesh {
+            positions: pts.to_vec(),
+            curves: vec![(0..pts.len() as u32).collect()],
+            ..Default::default()
+        };
+        CurveNetwork::from_mesh(&curves, 1e-9).unwrap()
+    }
+
+    fn closest(pos: &[Point3], tris: &[[u32; 3]], pts: &[Point3]) -> Vec<(u32, Point3, f64)> {
+        let all: Vec<u32> = (0..pts.len() as u32).collect();
+        super::super::insert::feet(pos, tris, pts, &all).unwrap()
+    }
+
+    #[test]
+    fn a_run_bulging_towards_the_other_sheet_keeps_its_own_sheet() {
+        let (pos, tris, vf) = plate();
+        // Nine points above the lower sheet; the 5th and 6th come within 0.03 of the upper one.
+        let pts: Vec<Point3> = (1..=9)
+            .map(|k| [0.1 * k as f64 - 0.03, 0.45, if k == 5 || k == 6 { 0.07 } else { 0.03 }])
+            .collect();
+        let net = network(&pts);
+        let anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
+        let c = closest(&pos, &tris, &pts);
+        assert!((c[4].1[2] - 0.1).abs() < 1e-12 && (c[5].1[2] - 0.1).abs() < 1e-12, "the case: closest points on the upper sheet");
+        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c);
+        assert_eq!(walked, 2);
+        for (p, f) in feet.iter().enumerate() {
+            assert!(f.1[2].abs() < 1e-12, "point {p} on the upper sheet");
+            // Straight below the point: the lower sheet's closest point.
+            assert!((f.1[0] - pts[p][0]).abs() < 1e-12 && (f.1[1] - 0.45).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_walk_from_a_wrong_end_is_not_followed() {
+        let (pos, tris, vf) = plate();
+        // The first point (an end, so an anchor keeping its closest point) is nearer the upper
+        // sheet, every other point the lower one: the forward walk stays on the upper sheet for
+        // the whole run, the backward walk (from the last point) on the lower one.
+        let pts: Vec<Point3> =
+            (1..=9).map(|k| [0.1 * k as f64 - 0.03, 0.45, if k == 1 { 0.08 } else { 0.02 }]).collect();
+        let net = network(&pts);
+        let anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
+        let c = closest(&pos, &tris, &pts);
+        let mut forward = c.clone();
+        let changed = super::super::insert::walk::walk_feet_directed(
+            &pos,
+            &tris,
+            &vf,
+            &net,
+            &mut forward,
+            &anchor,
+            false,
+        );
+        assert!(changed > 0 && (forward[4].1[2] - 0.1).abs() < 1e-12, "the case: the one-sided walk goes astray");
+        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone());
+        assert_eq!(walked, 0);
+        assert_eq!(feet.iter().map(|f| f.1).collect::<Vec<_>>(), c.iter().map(|f| f.1).collect::<Vec<_>>());
+    }
+}
