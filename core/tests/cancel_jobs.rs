@@ -145,6 +145,8 @@ fn report_stages_poll_inside() {
     // Seven passes (geometry, topology, faces, vertices, edges, components, boundary loops).
     assert!(stage_polls(&s, "validate_output") >= 7, "{s:?}");
     assert!(stage_polls(&s, "validate_input") >= 7, "{s:?}");
+    // outward: after the topology, after the components, then per 65,536 edges and faces.
+    assert!(stage_polls(&s, "outward") >= 4, "{s:?}");
     let (_, s) = polls(JobKind::Morph, &[icosphere(2, 1.0), icosphere(3, 1.0)], &json!({"frames": 2}));
     // Per input: the metamesh's vertices and the input's vertices and centroids, in chunks.
     assert!(stage_polls(&s, "report") >= 4, "{s:?}");
