@@ -111,8 +111,7 @@ const POLL_ITEMS: usize = 65_536;
 
 /// Flips closed, consistently oriented components whose signed volume is negative.
 pub fn outward(mesh: &mut Mesh, progress: &Progress) -> Result<OutwardReport> {
-    let topo = Topology::new(mesh);
-    progress.check()?;
+    let topo = Topology::new_polled(mesh, progress)?;
     let comps = topo.components(Connectivity::SharedEdge);
     progress.check()?;
     let nc = comps.count();
