@@ -346,7 +346,10 @@ mod tests {
         let net = network(&pts);
         let anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
         let c = closest(&pos, &tris, &pts);
-        assert!((c[4].1[2] - 0.1).abs() < 1e-12 && (c[5].1[2] - 0.1).abs() < 1e-12, "the case: closest points on the upper sheet");
+        assert!(
+            (c[4].1[2] - 0.1).abs() < 1e-12 && (c[5].1[2] - 0.1).abs() < 1e-12,
+            "the case: closest points on the upper sheet"
+        );
         let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c);
         assert_eq!(walked, 2);
         for (p, f) in feet.iter().enumerate() {
@@ -377,7 +380,10 @@ mod tests {
             &anchor,
             false,
         );
-        assert!(changed > 0 && (forward[4].1[2] - 0.1).abs() < 1e-12, "the case: the one-sided walk goes astray");
+        assert!(
+            changed > 0 && (forward[4].1[2] - 0.1).abs() < 1e-12,
+            "the case: the one-sided walk goes astray"
+        );
         let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone());
         assert_eq!(walked, 0);
         assert_eq!(feet.iter().map(|f| f.1).collect::<Vec<_>>(), c.iter().map(|f| f.1).collect::<Vec<_>>());
