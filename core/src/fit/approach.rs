@@ -42,6 +42,8 @@ pub struct ApproachReport {
 
 /// Field refinement tolerance, × the curves' median segment length ([`super::field_refine`]).
 const FIELD_TOLERANCE: f64 = 0.1;
+/// Templates whose median edge is below this × the curves' median segment are not refined.
+const FINE_TEMPLATE_EDGE: f64 = 0.5;
 /// The field refinement adds at most this many faces per curve vertex, over the template's.
 const FIELD_FACES_PER_CURVE_VERTEX: usize = 4;
 /// Extra runs of the densest level at most.
@@ -126,7 +128,19 @@ pub fn approach(
         l.sort_by(f64::total_cmp);
         l.get(l.len() / 2).copied().unwrap_or(0.0)
     };
-    let refine_tolerance = FIELD_TOLERANCE * median;
+    // Only a template coarse against the curves can miss a field that bends at the curves'
+    // scale; a finer one follows it already (and is too large to check every edge of).
+    let template_edge = {
+        let mut l: Vec<f64> = tris.iter().map(|t| dist(pos[t[0] as usize], pos[t[1] as usize])).collect();
+        let k = l.len() / 2;
+        if l.is_empty() {
+            0.0
+        } else {
+            *l.select_nth_unstable_by(k, f64::total_cmp).1
+        }
+    };
+    let refine_tolerance =
+        if template_edge > FINE_TEMPLATE_EDGE * median { FIELD_TOLERANCE * median } else { 0.0 };
     let refine_min_edge = 0.25 * median;
     let max_faces = tris.len() + FIELD_FACES_PER_CURVE_VERTEX * net.points.len();
     // The densest level is repeated (up to [`MAX_REPEATS`] times) while its own samples end
