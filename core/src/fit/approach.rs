@@ -42,8 +42,9 @@ pub struct ApproachReport {
 
 /// Field refinement tolerance, × the curves' median segment length ([`super::field_refine`]).
 const FIELD_TOLERANCE: f64 = 0.1;
-/// Templates whose median edge is below this × the curves' median segment are not refined.
-const FINE_TEMPLATE_EDGE: f64 = 0.5;
+/// Templates whose median edge is below this × the curves' median segment are not refined
+/// (the 96k headline, whose edges are about as long as its curve segments, is not).
+const FINE_TEMPLATE_EDGE: f64 = 2.0;
 /// The field refinement adds at most this many faces per curve vertex, over the template's.
 const FIELD_FACES_PER_CURVE_VERTEX: usize = 4;
 /// Extra runs of the densest level at most.
