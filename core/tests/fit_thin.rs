@@ -1,91 +1,16 @@
 //! Fits where the curves turn faster than the template's faces are long: a sphere reaching into
-//! spot's legs, ears and muzzle, and the rim of a flattened ellipsoid. Truths: the region count the
-//! section planes cut the source surface into (counted on a finer copy, independently of the fit),
-//! and, for the field refinement, what a linear field and a single spike must do by hand.
+//! spot's legs, ears and muzzle, and the rim of a flattened ellipsoid. Truth: the region count the
+//! section planes cut the source surface into (counted on a finer copy, independently of the fit).
+//! Both are open (ignored repros); see docs/benchmarks.md, "Thin shapes" (fit-shapes, session 7),
+//! and the branch `fit-shapes-field-refine`, which fixes the first but breaks fit_dense_curves.
 
-use meshwork_core::fit::field_refine::refine_for_field;
-use meshwork_core::fit::rbf::{Kernel, Rbf};
 use meshwork_core::fit::testdata::{bend, plane_sections, section_regions, sweep_planes, to_unit_box};
 use meshwork_core::fit::{run, FitParams};
-use meshwork_core::geometry::dist;
 use meshwork_core::io::{read, ReadOptions};
-use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::mesh::Mesh;
 use meshwork_core::repair::{self, RepairParams};
-use meshwork_core::shapes::{fan_triangles, grid, icosphere};
+use meshwork_core::shapes::icosphere;
 use meshwork_core::Progress;
-
-fn flat_grid() -> (Vec<Point3>, Vec<[u32; 3]>) {
-    let g = grid(8, 8, 1.0 / 8.0, false);
-    (g.positions.clone(), fan_triangles(&g.faces))
-}
-
-#[test]
-fn a_linear_field_refines_nothing() {
-    // An affine displacement is reproduced exactly by the RBF's polynomial part: the midpoint of
-    // every edge moves by the mean of its ends (deviation 0), so no face may be split.
-    let (mut pos, mut tris) = flat_grid();
-    let centres: Vec<Point3> =
-        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, 0.4, 0.5], [0.9, 0.8, 0.1]];
-    let values: Vec<Point3> =
-        centres.iter().map(|c| [0.1 * c[1], 0.2 * c[0] - 0.05, 0.3 * c[2] + 0.1 * c[0]]).collect();
-    let field = Rbf::fit(&centres, &values, Kernel::Linear, "test").unwrap();
-    let mut disp = field.eval_many(&pos, &Progress::new()).unwrap();
-    let (nf, nv) = (tris.len(), pos.len());
-    let mut parents = Vec::new();
-    let s = refine_for_field(
-        &mut pos,
-        &mut tris,
-        &mut parents,
-        &mut disp,
-        &field,
-        1e-6,
-        0.0,
-        10_000,
-        &Progress::new(),
-    )
-    .unwrap();
-    assert_eq!((s.faces_added, tris.len(), pos.len(), parents.len()), (0, nf, nv, 0));
-    assert!(s.deviation_max < 1e-9, "deviation {}", s.deviation_max);
-}
-
-#[test]
-fn a_spike_refines_around_it_only_and_the_new_vertices_take_the_field() {
-    // One centre of a flat grid pulled up by 0.2, the corners held: φ = r bends only near the
-    // spike (a cone), so splits must stay near it and each new vertex must carry the field's value.
-    let (mut pos, mut tris) = flat_grid();
-    let spike: Point3 = [0.5625, 0.4375, 0.0];
-    // (A held centre off the plane makes the centres non-coplanar.)
-    let mut centres: Vec<Point3> =
-        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.5, 0.5, 1.0]];
-    let mut values: Vec<Point3> = vec![[0.0; 3]; 5];
-    centres.push(spike);
-    values.push([0.0, 0.0, 0.2]);
-    let field = Rbf::fit(&centres, &values, Kernel::Linear, "test").unwrap();
-    let mut disp = field.eval_many(&pos, &Progress::new()).unwrap();
-    let nv = pos.len();
-    let mut parents = Vec::new();
-    let s = refine_for_field(
-        &mut pos,
-        &mut tris,
-        &mut parents,
-        &mut disp,
-        &field,
-        0.01,
-        0.02,
-        10_000,
-        &Progress::new(),
-    )
-    .unwrap();
-    assert!(s.faces_added > 0, "the spike must be refined");
-    assert_eq!(disp.len(), pos.len());
-    assert_eq!(parents.len(), pos.len() - nv);
-    for v in nv..pos.len() {
-        // New vertices: edge midpoints, near the spike (the cone's kink), with the field's value.
-        assert!(dist(pos[v], spike) < 0.3, "split far from the spike at {:?}", pos[v]);
-        let f = field.eval(pos[v]);
-        assert!(dist(f, disp[v]) < 1e-12);
-    }
-}
 
 fn spot_unit() -> Mesh {
     let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/meshes/spot.obj"))
@@ -100,9 +25,9 @@ fn spot_unit() -> Mesh {
 }
 
 #[test]
+#[ignore = "open: 21 flipped faces on main (1 with the field refinement of branch fit-shapes-field-refine)"]
 fn a_sphere_reaches_spots_legs_without_folds() {
-    // sweep_unseen's "icosphere vs sections of spot (auto)": 21 flipped faces before the approach
-    // refined the template where its field bends and repeated its densest level (then 1).
+    // sweep_unseen's "icosphere vs sections of spot (auto)".
     let spot = spot_unit();
     let planes = sweep_planes(&spot);
     let expected = section_regions(&spot, &planes);
