@@ -35,22 +35,7 @@ pub struct ApproachReport {
     /// level moved it (what the level corrects).
     pub distance_max: Vec<f64>,
     pub distance_mean: Vec<f64>,
-    /// Per level: the template refined where the level's field bends within a face
-    /// ([`super::field_refine`]).
-    pub refined: Vec<super::field_refine::FieldRefineStats>,
 }
-
-/// Field refinement tolerance, × the curves' median segment length ([`super::field_refine`]).
-const FIELD_TOLERANCE: f64 = 0.1;
-/// Templates whose median edge is below this × the curves' median segment are not refined
-/// (the 96k headline, whose edges are about as long as its curve segments, is not).
-const FINE_TEMPLATE_EDGE: f64 = 2.0;
-/// The field refinement adds at most this many faces per curve vertex, over the template's.
-const FIELD_FACES_PER_CURVE_VERTEX: usize = 4;
-/// Extra runs of the densest level at most.
-const MAX_REPEATS: usize = 2;
-/// The densest level is repeated while its samples end farther than this × the median segment.
-const REPEAT_DISTANCE: f64 = 0.5;
 
 /// Sample counts per level: each level uses 4× the centres of the previous one, the last at most
 /// a quarter of the curve vertices (the exact fit does the rest).
@@ -68,11 +53,9 @@ fn level_sizes(n: usize, levels: usize) -> Vec<usize> {
 /// Moves `pos` towards the curves in up to `levels` levels. `fixed` template vertices (user pairs
 /// already on their curve points) are centres with zero displacement at every level. Nothing moves
 /// when a curve vertex is farther than `max_distance` from the surface.
-#[allow(clippy::too_many_arguments)]
 pub fn approach(
-    pos: &mut Vec<Point3>,
-    tris: &mut Vec<[u32; 3]>,
-    parents: &mut Vec<[(u32, f64); 3]>,
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
     net: &CurveNetwork,
     fixed: &[(u32, u32)],
     kernel: Kernel,
@@ -85,16 +68,12 @@ pub fn approach(
     if sizes.is_empty() {
         return Ok(report);
     }
-    let faces_around = |nv: usize, tris: &[[u32; 3]]| {
-        let mut vf: Vec<Vec<u32>> = vec![Vec::new(); nv];
-        for (f, t) in tris.iter().enumerate() {
-            for &v in t {
-                vf[v as usize].push(f as u32);
-            }
+    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            vf[v as usize].push(f as u32);
         }
-        vf
-    };
-    let mut vf = faces_around(pos.len(), tris);
+    }
     let is_fixed_point = {
         let mut m = vec![false; net.points.len()];
         for &(p, _) in fixed {
@@ -109,53 +88,23 @@ pub fn approach(
     // pieces the nearest vertex can be on another piece passing close by (raw suzanne: the eyes
     // were pulled onto the head's curves, 7 flips), so the exact search is used there.
     let in_pieces = super::insert::walk::face_components(pos.len(), tris).iter().any(|&c| c != 0);
-    let feet_of = |pos: &[Point3], tris: &[[u32; 3]], vf: &[Vec<u32>], which: &[u32]| {
+    let feet_of = |pos: &[Point3], which: &[u32]| {
         if in_pieces {
             super::insert::feet(pos, tris, &net.points, which)
         } else {
-            super::insert::feet_near_vertex(pos, tris, vf, &net.points, which)
+            super::insert::feet_near_vertex(pos, tris, &vf, &net.points, which)
         }
     };
-    if feet_of(pos, tris, &vf, &all)?.iter().any(|f| f.2 > max_distance) {
+    if feet_of(pos, &all)?.iter().any(|f| f.2 > max_distance) {
         return Ok(report);
     }
     let length: f64 =
         net.segments.iter().map(|s| dist(net.points[s[0] as usize], net.points[s[1] as usize])).sum();
-    // Field refinement (see [`super::field_refine`]): feet must land within a tenth of the
-    // curves' median segment; no edge is split below a quarter of it.
-    let median = {
-        let mut l: Vec<f64> =
-            net.segments.iter().map(|s| dist(net.points[s[0] as usize], net.points[s[1] as usize])).collect();
-        l.sort_by(f64::total_cmp);
-        l.get(l.len() / 2).copied().unwrap_or(0.0)
-    };
-    // Only a template coarse against the curves can miss a field that bends at the curves'
-    // scale; a finer one follows it already (and is too large to check every edge of).
-    let template_edge = {
-        let mut l: Vec<f64> = tris.iter().map(|t| dist(pos[t[0] as usize], pos[t[1] as usize])).collect();
-        let k = l.len() / 2;
-        if l.is_empty() {
-            0.0
-        } else {
-            *l.select_nth_unstable_by(k, f64::total_cmp).1
-        }
-    };
-    let refine_tolerance =
-        if template_edge > FINE_TEMPLATE_EDGE * median { FIELD_TOLERANCE * median } else { 0.0 };
-    let refine_min_edge = 0.25 * median;
-    let max_faces = tris.len() + FIELD_FACES_PER_CURVE_VERTEX * net.points.len();
-    // The densest level is repeated (up to [`MAX_REPEATS`] times) while its own samples end
-    // farther than half the median segment from the curves after it moved: the surface is still
-    // converging (measured on spot's sections with a level-3 icosphere: 3.3e-2 → 1.2e-2 → 1.1e-3
-    // over two repeats, and 21 → 1 flipped faces; without the field refinement the repeats do not
-    // converge, 23 flips, as fit-loops found).
-    let mut queue: std::collections::VecDeque<(usize, usize)> =
-        sizes.iter().enumerate().map(|(i, &s)| (s, (i + 1 == sizes.len()) as usize * MAX_REPEATS)).collect();
-    while let Some((size, repeats_left)) = queue.pop_front() {
+    for &size in &sizes {
         progress.check()?;
         let h = length / size as f64;
         let sample = spread_sample(net, h, &is_fixed_point);
-        let feet = feet_of(pos, tris, &vf, &sample)?;
+        let feet = feet_of(pos, &sample)?;
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());
@@ -173,26 +122,9 @@ pub fn approach(
             continue;
         }
         let Ok(field) = Rbf::fit(&centres, &values, kernel, "fine") else { continue };
-        let mut disp = field.eval_many(pos, progress)?;
-        if refine_tolerance > 0.0 {
-            let s = super::field_refine::refine_for_field(
-                pos,
-                tris,
-                parents,
-                &mut disp,
-                &field,
-                refine_tolerance,
-                refine_min_edge,
-                max_faces,
-                progress,
-            )?;
-            if s.faces_added > 0 {
-                vf = faces_around(pos.len(), tris);
-            }
-            report.refined.push(s);
-        }
+        let disp = field.eval_many(pos, progress)?;
         let mut step = 1.0;
-        let moved: Vec<Point3> = loop {
+        let moved = loop {
             let moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, scale(*d, step))).collect();
             if step < 0.1 || folds(pos, &moved, tris) == 0 {
                 break moved;
@@ -207,13 +139,6 @@ pub fn approach(
         pos.copy_from_slice(&moved);
         for &(p, v) in fixed {
             pos[v as usize] = net.points[p as usize];
-        }
-        if repeats_left > 0 {
-            let after = feet_of(pos, tris, &vf, &sample)?;
-            let left = after.iter().map(|f| f.2).fold(0.0, f64::max);
-            if left > REPEAT_DISTANCE * median {
-                queue.push_back((size, repeats_left - 1));
-            }
         }
         report.centres.push(centres.len());
         report.step.push(step);
