@@ -18,6 +18,12 @@ use serde_json::{json, Value};
 /// Runs the job to completion; returns the total number of polls and, per stage in run order,
 /// the polls made inside it after its entry check.
 fn polls(kind: JobKind, inputs: &[Mesh], params: &Value) -> (u64, Vec<(String, u64)>) {
+    let (total, per_stage, _) = polls_and_report(kind, inputs, params);
+    (total, per_stage)
+}
+
+/// [`polls`] and the job's report.
+fn polls_and_report(kind: JobKind, inputs: &[Mesh], params: &Value) -> (u64, Vec<(String, u64)>, Value) {
     let p = Progress::new();
     let marks: Arc<Mutex<Vec<(String, u64)>>> = Arc::default();
     {
@@ -29,7 +35,8 @@ fn polls(kind: JobKind, inputs: &[Mesh], params: &Value) -> (u64, Vec<(String, u
             }
         });
     }
-    job::run(kind, inputs.to_vec(), params.clone(), &p).unwrap_or_else(|e| panic!("{kind:?} {params}: {e}"));
+    let out = job::run(kind, inputs.to_vec(), params.clone(), &p)
+        .unwrap_or_else(|e| panic!("{kind:?} {params}: {e}"));
     let total = p.checks();
     let marks = marks.lock().unwrap().clone();
     let mut per_stage = Vec::new();
@@ -37,7 +44,7 @@ fn polls(kind: JobKind, inputs: &[Mesh], params: &Value) -> (u64, Vec<(String, u
         let end = marks.get(i + 1).map_or(total, |m| m.1);
         per_stage.push((name.clone(), end - start - 1));
     }
-    (total, per_stage)
+    (total, per_stage, out.report)
 }
 
 /// Cancels the job at up to 12 polls spread over its run (the first and the last included) and
@@ -141,4 +148,29 @@ fn report_stages_poll_inside() {
     let (_, s) = polls(JobKind::Morph, &[icosphere(2, 1.0), icosphere(3, 1.0)], &json!({"frames": 2}));
     // Per input: the metamesh's vertices and the input's vertices and centroids, in chunks.
     assert!(stage_polls(&s, "report") >= 4, "{s:?}");
+}
+
+/// The two longest stretches without a poll left after the report stages (cancel_latency,
+/// docs/benchmarks.md): validate's duplicate-face search (one sort of all faces, 136 ms on 280k
+/// faces) and highlight fairing's QP step (CG polled every 256 iterations, the Hessian's triplets
+/// sorted in one call, 300 ms at 30k unknowns). Both now poll in proportion to their work.
+#[test]
+fn long_passes_poll_in_proportion_to_their_work() {
+    // validate `faces`: a scan poll every 65,536 faces and a duplicate-search poll every 32,768.
+    let big = icosphere(6, 1.0); // 81,920 triangles
+    let (_, s) = polls(JobKind::Validate, &[big], &json!({}));
+    assert!(stage_polls(&s, "faces") >= 2 + 3, "{s:?}");
+
+    // highlight `fair`: at least one poll per CG iteration and per outer QP iteration.
+    let params = json!({"method": "highlight", "region_all": true, "iterations": 3, "light_normal": [0, 0, 1],
+                        "light_direction": [1, 0, 0], "light_origin": [0, 0, 3], "light_spacing": 0.1});
+    let (_, s, report) = polls_and_report(JobKind::Smooth, &[bumped_grid()], &params);
+    let history = report["history"].as_array().unwrap_or_else(|| panic!("no history in {report}"));
+    let work: u64 = history
+        .iter()
+        .map(|h| h["qp"]["cg_iterations"].as_u64().unwrap() + h["qp"]["outer_iterations"].as_u64().unwrap())
+        .sum();
+    assert!(work > 16, "too small a problem to tell: {work} QP iterations");
+    let fair_polls = stage_polls(&s, "fair");
+    assert!(fair_polls >= work, "fair polled {fair_polls} times for {work} CG + outer QP iterations");
 }

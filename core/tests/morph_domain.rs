@@ -7,16 +7,15 @@
 use std::f64::consts::{PI, TAU};
 
 use meshwork_core::error::Error;
-use meshwork_core::geometry::{norm, sub, triangle_area, Aabb};
+use meshwork_core::geometry::{norm, sub, triangle_area};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::domain::{measure_loops, rim_rule, Chosen, RIM_DOMINANCE, RIM_SPAN};
 use meshwork_core::shapes;
-use meshwork_core::spatial::closest_on_triangle;
 use serde_json::json;
 
 mod morph_support;
-use morph_support::load;
+use morph_support::{bbox_diag, dist_brute, load, relative_distance_brute};
 
 const RINGS: usize = 10;
 const SEG: usize = 24;
@@ -28,10 +27,6 @@ fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     shapes::fan_triangles(&m.faces)
 }
 
-fn diag(p: &[Point3]) -> f64 {
-    Aabb::of(p).expect("non-empty").diagonal()
-}
-
 fn area(m: &Mesh) -> f64 {
     tris_of(m)
         .iter()
@@ -39,18 +34,6 @@ fn area(m: &Mesh) -> f64 {
             triangle_area(m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize])
         })
         .sum()
-}
-
-/// Distance from `p` to the triangles `tris` over `pos` (brute force).
-fn dist_to(p: Point3, pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
-    tris.iter()
-        .map(|t| {
-            norm(sub(
-                p,
-                closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
-            ))
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The upper unit hemisphere of `RINGS` rings of `SEG` vertices (the last on the equator is the
@@ -141,20 +124,20 @@ fn rim_length() -> f64 {
 /// against the hemisphere without any code of the morph or the repair.
 fn assert_is_patched_hemisphere(frame: &Mesh, damaged: &Mesh) {
     let (ft, dt) = (tris_of(frame), tris_of(damaged));
-    let d = diag(&damaged.positions);
+    let d = bbox_diag(&damaged.positions);
     // Every vertex of the damaged input lies on the frame, and every frame vertex away from the
     // hole lies on the damaged input.
     let mut worst_in = 0.0f64;
     for (v, p) in damaged.positions.iter().enumerate() {
         if dt.iter().any(|t| t.contains(&(v as u32))) {
-            worst_in = worst_in.max(dist_to(*p, &frame.positions, &ft));
+            worst_in = worst_in.max(dist_brute(*p, &frame.positions, &ft));
         }
     }
     let mut worst_out = 0.0f64;
     let mut in_hole = 0;
     for p in &frame.positions {
         if norm(sub(*p, HOLE_AT)) > HOLE_R + 0.2 {
-            worst_out = worst_out.max(dist_to(*p, &damaged.positions, &dt));
+            worst_out = worst_out.max(dist_brute(*p, &damaged.positions, &dt));
         } else {
             // The patch stays close to the missing spherical cap (its sagitta is < 0.06).
             assert!((norm(*p) - 1.0).abs() < 0.06, "patch vertex {p:?} off the sphere by {}", norm(*p) - 1.0);
@@ -222,15 +205,7 @@ fn disk_with_an_extra_hole_is_morphed_after_repair_with_domain_disk_and_auto() {
         assert_eq!(rep[1]["summary"]["holes_filled"], 0);
         // Independent checks of the end frames.
         assert_is_patched_hemisphere(&out.meshes[0], &damaged);
-        let (tt, mt) = (tris_of(&target), tris_of(&out.meshes[1]));
-        let d = diag(&target.positions);
-        let h1 = target
-            .positions
-            .iter()
-            .map(|&p| dist_to(p, &out.meshes[1].positions, &mt))
-            .chain(out.meshes[1].positions.iter().map(|&p| dist_to(p, &target.positions, &tt)))
-            .fold(0.0, f64::max)
-            / d;
+        let h1 = relative_distance_brute(&target, &out.meshes[1]);
         assert!(h1 < 1e-9, "last frame vs target {h1}");
     }
 }
@@ -260,14 +235,7 @@ fn disk_with_a_fin_and_a_stray_piece_is_repaired_and_morphed() {
         assert_eq!(s["vertices_out"], hemisphere().positions.len(), "{s}");
         // The first frame is the clean hemisphere (no fin, no hole).
         let clean = hemisphere();
-        let (ct, ft) = (tris_of(&clean), tris_of(&out.meshes[0]));
-        let h = clean
-            .positions
-            .iter()
-            .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
-            .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &clean.positions, &ct)))
-            .fold(0.0, f64::max)
-            / diag(&clean.positions);
+        let h = relative_distance_brute(&clean, &out.meshes[0]);
         assert!(h < 1e-9, "first frame vs hemisphere {h}");
     }
 }
@@ -411,7 +379,7 @@ fn feature_indices_survive_the_repair_renumbering() {
     let pa = damaged.positions[va as usize];
     let k = (0..m0.len()).min_by(|&i, &j| norm(sub(m0[i], pa)).total_cmp(&norm(sub(m0[j], pa)))).unwrap();
     assert!(norm(sub(m0[k], pa)) < 1e-9, "source vertex not in the metamesh");
-    let gap = norm(sub(m1[k], target.positions[vb as usize])) / diag(&target.positions);
+    let gap = norm(sub(m1[k], target.positions[vb as usize])) / bbox_diag(&target.positions);
     assert!(gap < 1e-3, "feature ({va}, {vb}) ends {gap} apart; {}", out.report["features"]);
 }
 
@@ -435,14 +403,7 @@ fn hole_touching_the_rim_at_a_vertex_is_filled() {
         let s = &r["repair"][0]["summary"];
         assert_eq!((s["holes_filled"].as_u64(), s["faces_added"].as_u64()), (Some(1), Some(1)), "{s}");
         assert_eq!(s["outer_boundary_edges"], SEG, "{s}");
-        let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
-        let d = h
-            .positions
-            .iter()
-            .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
-            .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
-            .fold(0.0, f64::max)
-            / diag(&h.positions);
+        let d = relative_distance_brute(&h, &out.meshes[0]);
         assert!(d < 1e-9, "first frame vs hemisphere {d}");
         assert!((area(&out.meshes[0]) / area(&h) - 1.0).abs() < 1e-12);
     }
@@ -489,14 +450,7 @@ fn welded_seam_is_counted_and_the_surface_restored() {
     assert_eq!(s["vertices_removed_unreferenced"], RINGS, "{s}");
     assert_eq!(s["vertices_out"], h.positions.len(), "{s}");
     assert_eq!(s["holes_filled"], 0, "{s}");
-    let (ct, ft) = (tris_of(&h), tris_of(&out.meshes[0]));
-    let d = h
-        .positions
-        .iter()
-        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
-        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &h.positions, &ct)))
-        .fold(0.0, f64::max)
-        / diag(&h.positions);
+    let d = relative_distance_brute(&h, &out.meshes[0]);
     assert!(d < 1e-9, "first frame vs hemisphere {d}");
     // The rim is the hemisphere's again: SEG edges on the equator.
     assert!(boundary_edges(&out.meshes[0])
@@ -524,14 +478,7 @@ fn sphere_with_one_small_hole_is_a_disk_as_is_and_a_sphere_after_repair() {
     assert_eq!(r["repair"][0]["summary"]["faces_added"], 1);
     assert_eq!(r["foldovers"], json!([0, 0]));
     // The one-triangle hole is closed by that triangle: the first frame is the icosphere.
-    let (st, ft) = (tris_of(&s), tris_of(&out.meshes[0]));
-    let d = s
-        .positions
-        .iter()
-        .map(|&p| dist_to(p, &out.meshes[0].positions, &ft))
-        .chain(out.meshes[0].positions.iter().map(|&p| dist_to(p, &s.positions, &st)))
-        .fold(0.0, f64::max)
-        / diag(&s.positions);
+    let d = relative_distance_brute(&s, &out.meshes[0]);
     assert!(d < 1e-9, "first frame vs icosphere {d}");
 }
 

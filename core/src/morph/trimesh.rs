@@ -127,6 +127,24 @@ pub struct TopologyInfo {
     pub genus: Option<i64>,
 }
 
+impl TopologyInfo {
+    /// What keeps the mesh from being one manifold piece (several components, non-manifold
+    /// edges or vertices), in words; empty when nothing does.
+    pub fn defects(&self) -> Vec<String> {
+        let mut s = Vec::new();
+        if self.components != 1 {
+            s.push(format!("{} connected components", self.components));
+        }
+        if self.non_manifold_edges > 0 {
+            s.push(format!("{} non-manifold edges", self.non_manifold_edges));
+        }
+        if self.non_manifold_vertices > 0 {
+            s.push(format!("{} non-manifold vertices", self.non_manifold_vertices));
+        }
+        s
+    }
+}
+
 /// Counts of the mesh's topology (edges, boundary loops, non-manifold parts, components, genus).
 pub fn topology(m: &TriMesh) -> TopologyInfo {
     let nv = m.pos.len();
@@ -286,15 +304,7 @@ pub fn require_sphere_like(info: &TopologyInfo, which: &str) -> Result<()> {
     if info.faces < 4 {
         problems.push(format!("only {} faces", info.faces));
     }
-    if info.components != 1 {
-        problems.push(format!("{} connected components", info.components));
-    }
-    if info.non_manifold_edges > 0 {
-        problems.push(format!("{} non-manifold edges", info.non_manifold_edges));
-    }
-    if info.non_manifold_vertices > 0 {
-        problems.push(format!("{} non-manifold vertices", info.non_manifold_vertices));
-    }
+    problems.extend(info.defects());
     if info.boundary_loops > 0 {
         // χ = 2 − 2g − b for a connected manifold surface with b boundary loops.
         let g = 2 - info.boundary_loops as i64 - info.euler_characteristic;

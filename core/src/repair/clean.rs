@@ -2,6 +2,8 @@
 
 use serde::Serialize;
 
+use crate::error::Result;
+use crate::job::Progress;
 use crate::mesh::{Faces, Mesh};
 use crate::topology::NONE;
 use crate::validate::{distinct_count, polygon_area, ZERO_AREA_REL};
@@ -19,7 +21,13 @@ pub struct CleanReport {
 }
 
 /// Removes degenerate and/or duplicate faces, keeping the order and groups of the rest.
-pub fn clean(mesh: &mut Mesh, degenerate: bool, duplicates: bool, diag: f64) -> CleanReport {
+pub fn clean(
+    mesh: &mut Mesh,
+    degenerate: bool,
+    duplicates: bool,
+    diag: f64,
+    progress: &Progress,
+) -> Result<CleanReport> {
     let mut r = CleanReport::default();
     let zero = ZERO_AREA_REL * diag * diag;
     let mut out = Faces::with_capacity(mesh.faces.len(), mesh.faces.indices().len());
@@ -48,7 +56,7 @@ pub fn clean(mesh: &mut Mesh, degenerate: bool, duplicates: bool, diag: f64) -> 
         out.push(&buf, mesh.faces.group(i));
     }
     if duplicates {
-        let dups = crate::validate::duplicate_faces(&out);
+        let dups = crate::validate::duplicate_faces_polled(&out, progress)?;
         r.dropped_duplicates = dups.len();
         if !dups.is_empty() {
             let mut drop = vec![false; out.len()];
@@ -59,7 +67,7 @@ pub fn clean(mesh: &mut Mesh, degenerate: bool, duplicates: bool, diag: f64) -> 
         }
     }
     mesh.faces = out;
-    r
+    Ok(r)
 }
 
 #[derive(Debug, Clone, Serialize, Default)]
@@ -134,7 +142,7 @@ mod tests {
         f.push(&[2, 1, 0], 0); // duplicate of face 0 after collapse
         f.push(&[0, 2, 3], 1);
         let mut m = Mesh::new(p, f);
-        let r = clean(&mut m, true, true, 2.0);
+        let r = clean(&mut m, true, true, 2.0, &Progress::new()).unwrap();
         assert_eq!(r.collapsed_corners, 2);
         assert_eq!(r.dropped_repeated_index, 1);
         assert_eq!(r.dropped_zero_area, 1);

@@ -177,7 +177,7 @@ pub fn fill(mesh: &mut Mesh, opts: &FillOptions, progress: &Progress) -> Result<
             patch.refine(s, &exists, progress)?;
         }
         if opts.fair && patch.pos.len() > n {
-            let res = super::fair::harmonic(&mut patch.pos, n, &patch.tris)?;
+            let res = super::fair::harmonic(&mut patch.pos, n, &patch.tris, progress)?;
             r.fair_max_residual = r.fair_max_residual.max(res);
         }
         // Commit: new vertices, faces, created edges.
@@ -538,9 +538,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn dp_flat_square_hole_minimal() {
-        // A 4×4 quad grid with the middle 2×2 cells removed: a planar 8-edge hole.
+    /// A 4×4 quad grid with the middle 2×2 cells removed: a planar 8-edge hole in a 16-edge rim.
+    fn grid_with_square_hole() -> Mesh {
         let g = shapes::grid(4, 4, 1.0, true);
         let mut faces = Faces::new();
         for (i, f) in g.faces.iter().enumerate() {
@@ -549,7 +548,13 @@ mod tests {
                 faces.push(f, 0);
             }
         }
-        let mut m = Mesh::new(g.positions, faces);
+        Mesh::new(g.positions, faces)
+    }
+
+    #[test]
+    fn dp_flat_square_hole_minimal() {
+        // A 4×4 quad grid with the middle 2×2 cells removed: a planar 8-edge hole.
+        let mut m = grid_with_square_hole();
         let opts =
             FillOptions { refine: false, fair: false, max_hole_area_ratio: 10.0, ..Default::default() };
         let r = fill(&mut m, &opts, &Progress::new()).unwrap();
@@ -565,15 +570,7 @@ mod tests {
     fn keep_open_leaves_the_named_loop_and_fills_the_rest() {
         // As above (4×4 grid, 2×2 hole), but the rim is named by one of its edges (0–1, on y = 0):
         // only the 8-edge inner hole is filled, with area 4.
-        let g = shapes::grid(4, 4, 1.0, true);
-        let mut faces = Faces::new();
-        for (i, f) in g.faces.iter().enumerate() {
-            let (cx, cy) = (i % 4, i / 4);
-            if !((1..3).contains(&cx) && (1..3).contains(&cy)) {
-                faces.push(f, 0);
-            }
-        }
-        let mut m = Mesh::new(g.positions, faces);
+        let mut m = grid_with_square_hole();
         let opts = FillOptions {
             refine: false,
             fair: false,

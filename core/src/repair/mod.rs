@@ -265,7 +265,7 @@ fn mend_topology(r: &mut Repairing, params: &RepairParams, input: &validate::Rep
         r.step(
             "clean",
             "clean",
-            |m, _| Ok(clean::clean(m, params.remove_degenerate, params.remove_duplicates, diag)),
+            |m, p| clean::clean(m, params.remove_degenerate, params.remove_duplicates, diag, p),
             |c| {
                 c.collapsed_corners + c.dropped_repeated_index + c.dropped_zero_area + c.dropped_duplicates
                     > 0

@@ -25,18 +25,28 @@ pub fn bbox_diag(p: &[Point3]) -> f64 {
 
 /// Max over `pts` of the distance to the nearest triangle of (pos, tris), by brute force.
 pub fn max_dist_brute(pts: &[Point3], pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
-    pts.iter()
-        .map(|&p| {
-            tris.iter()
-                .map(|t| {
-                    norm(sub(
-                        p,
-                        closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
-                    ))
-                })
-                .fold(f64::INFINITY, f64::min)
+    pts.iter().map(|&p| dist_brute(p, pos, tris)).fold(0.0, f64::max)
+}
+
+/// Distance from `p` to the nearest triangle of (pos, tris), by brute force.
+pub fn dist_brute(p: Point3, pos: &[Point3], tris: &[[u32; 3]]) -> f64 {
+    tris.iter()
+        .map(|t| {
+            norm(sub(
+                p,
+                closest_on_triangle(p, &[pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]]),
+            ))
         })
-        .fold(0.0, f64::max)
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Symmetric vertex-to-surface distance between `a` and `b` (each one's vertices to the other's
+/// triangles, by brute force), relative to `a`'s bounding-box diagonal.
+pub fn relative_distance_brute(a: &Mesh, b: &Mesh) -> f64 {
+    let (ta, tb) =
+        (meshwork_core::shapes::fan_triangles(&a.faces), meshwork_core::shapes::fan_triangles(&b.faces));
+    max_dist_brute(&a.positions, &b.positions, &tb).max(max_dist_brute(&b.positions, &a.positions, &ta))
+        / bbox_diag(&a.positions)
 }
 
 /// Area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee), signed.

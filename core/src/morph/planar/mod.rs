@@ -68,16 +68,7 @@ pub fn genus_of(info: &TopologyInfo) -> Option<i64> {
 
 /// The refusal for an input that is neither a closed genus-0 surface nor a disk.
 pub fn describe(info: &TopologyInfo) -> String {
-    let mut s = Vec::new();
-    if info.components != 1 {
-        s.push(format!("{} connected components", info.components));
-    }
-    if info.non_manifold_edges > 0 {
-        s.push(format!("{} non-manifold edges", info.non_manifold_edges));
-    }
-    if info.non_manifold_vertices > 0 {
-        s.push(format!("{} non-manifold vertices", info.non_manifold_vertices));
-    }
+    let mut s = info.defects();
     match genus_of(info) {
         Some(g) => s.push(format!("genus {g} with {} boundary loops", info.boundary_loops)),
         None => s.push(format!(

@@ -23,8 +23,9 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::lines::{self, Adjacency, Lights, Model};
-use super::qp::{self, QpStats, SymCsr};
+use super::qp::{self, QpStats};
 use super::target::{self, Runs};
+use crate::laplacian::Csr;
 
 /// Halvings tried when a step flips a triangle or does not lower the target.
 pub const MAX_HALVINGS: usize = 6;
@@ -310,12 +311,22 @@ pub fn node_jacobian(
 
 /// The Gauss–Newton QP `min ½xᵀHx + cᵀx` of eq. 15 at the current positions.
 pub struct Quadratic {
-    pub h: SymCsr,
+    pub h: Csr,
     pub c: Vec<f64>,
     pub rows: usize,
 }
 
-pub fn quadratic(adj: &Adjacency, x: &[Point3], nrm: &[Point3], setup: &Setup, state: &State) -> Quadratic {
+/// Energy vertices (or line targets) whose rows are built between two polls of [`quadratic`].
+const ROWS_PER_POLL: usize = 1024;
+
+pub fn quadratic(
+    adj: &Adjacency,
+    x: &[Point3],
+    nrm: &[Point3],
+    setup: &Setup,
+    state: &State,
+    progress: &Progress,
+) -> Result<Quadratic> {
     let n = setup.vars.len();
     let mut trip: Vec<(u32, u32, f64)> = Vec::new();
     let mut c = vec![0.0; n];
@@ -332,7 +343,8 @@ pub fn quadratic(adj: &Adjacency, x: &[Point3], nrm: &[Point3], setup: &Setup, s
     // q_fair: residual sqrt(ω₁/Aᵢ) Σⱼ wᵢⱼ(V̄ᵢ − V̄ⱼ) with wᵢⱼ, Aᵢ frozen (§3.6).
     let w = cot_weights(adj, x);
     let area = bary_areas(adj, x);
-    for &i in &setup.energy_vertices {
+    for (k, &i) in setup.energy_vertices.iter().enumerate() {
+        progress.check_every(k, ROWS_PER_POLL)?;
         let i = i as usize;
         if !setup.affected[i] || area[i] <= 0.0 {
             continue;
@@ -356,6 +368,7 @@ pub fn quadratic(adj: &Adjacency, x: &[Point3], nrm: &[Point3], setup: &Setup, s
     // q_diff: residual sqrt(ω₂ lᵢ / e³)(Q̄ᵢ − Q̃ᵢ), Q̄ linearised.
     let e3 = setup.e.powi(3);
     for run in &state.runs.runs {
+        progress.check()?;
         for (node, tgt, l) in target::targets(&state.model, run) {
             let s = (setup.w_diff * l / e3).sqrt();
             let q = state.model.nodes[node as usize].pos;
@@ -366,16 +379,14 @@ pub fn quadratic(adj: &Adjacency, x: &[Point3], nrm: &[Point3], setup: &Setup, s
             }
         }
     }
-    let mut h = SymCsr::from_triplets(n, trip);
+    let mut h = Csr::from_triplets_polled(n, trip, progress)?;
     // A vanishing ridge keeps H definite for unknowns no residual sees (a flat, line-free patch).
     let dmax = h.diagonal().iter().fold(0.0f64, |m, v| m.max(*v));
     let ridge = 1e-12 * dmax.max(1e-300);
-    for i in 0..n {
-        if let Some(p) = (h.ptr[i]..h.ptr[i + 1]).find(|&p| h.col[p] as usize == i) {
-            h.val[p] += ridge;
-        }
+    for p in h.diagonal_positions() {
+        h.val[p] += ridge;
     }
-    Quadratic { h, c, rows }
+    Ok(Quadratic { h, c, rows })
 }
 
 /// One iteration's record for the report.
@@ -428,7 +439,7 @@ pub fn iterate(
     for it in 0..max_iterations {
         progress.fraction(it as f64 / max_iterations.max(1) as f64)?;
         let nrm = adj.normals(&x);
-        let quad = quadratic(adj, &x, &nrm, setup, &state);
+        let quad = quadratic(adj, &x, &nrm, setup, &state, progress)?;
         out.qp_nonzeros = out.qp_nonzeros.max(quad.h.nnz());
         let bound: Vec<f64> = setup
             .vars
@@ -450,6 +461,8 @@ pub fn iterate(
         let mut accepted = None;
         let mut halvings = 0;
         for h in 0..=MAX_HALVINGS {
+            // Each trial rebuilds the lines model of the whole region.
+            progress.check()?;
             let trial = moved(&x, &nrm, setup, &step, scale_f);
             // Against the previous step and against the input: a face may not turn by more than
             // 90° in one step nor accumulate that over several.
@@ -664,7 +677,7 @@ mod tests {
         let (adj, x, setup) = bumpy();
         let nrm = adj.normals(&x);
         let st = State::new(&adj, &x, &setup);
-        let quad = quadratic(&adj, &x, &nrm, &setup, &st);
+        let quad = quadratic(&adj, &x, &nrm, &setup, &st, &Progress::new()).unwrap();
         let frozen = |y: &[Point3]| -> f64 {
             let m2 = lines::model(&adj, y, &setup.lights);
             let mut f = 0.0;

@@ -10,65 +10,7 @@
 
 use crate::error::Result;
 use crate::job::Progress;
-
-/// Symmetric sparse matrix, both triangles stored (rows of `(col, value)`).
-#[derive(Debug, Clone, Default)]
-pub struct SymCsr {
-    pub n: usize,
-    pub ptr: Vec<usize>,
-    pub col: Vec<u32>,
-    pub val: Vec<f64>,
-}
-
-impl SymCsr {
-    /// Sums duplicate `(i, j, v)` entries; the caller supplies both `(i, j)` and `(j, i)`.
-    pub fn from_triplets(n: usize, mut t: Vec<(u32, u32, f64)>) -> SymCsr {
-        t.sort_unstable_by_key(|e| (e.0, e.1));
-        let mut m = SymCsr { n, ptr: vec![0; n + 1], col: Vec::new(), val: Vec::new() };
-        let mut last: Option<(u32, u32)> = None;
-        for (i, j, v) in t {
-            if last == Some((i, j)) {
-                if let Some(x) = m.val.last_mut() {
-                    *x += v;
-                }
-            } else {
-                m.col.push(j);
-                m.val.push(v);
-                m.ptr[i as usize + 1] += 1;
-                last = Some((i, j));
-            }
-        }
-        for i in 0..n {
-            m.ptr[i + 1] += m.ptr[i];
-        }
-        m
-    }
-
-    pub fn mul(&self, x: &[f64], y: &mut [f64]) {
-        for i in 0..self.n {
-            let mut s = 0.0;
-            for p in self.ptr[i]..self.ptr[i + 1] {
-                s += self.val[p] * x[self.col[p] as usize];
-            }
-            y[i] = s;
-        }
-    }
-
-    pub fn nnz(&self) -> usize {
-        self.val.len()
-    }
-
-    pub fn diagonal(&self) -> Vec<f64> {
-        (0..self.n)
-            .map(|i| {
-                (self.ptr[i]..self.ptr[i + 1])
-                    .find(|&p| self.col[p] as usize == i)
-                    .map(|p| self.val[p])
-                    .unwrap_or(0.0)
-            })
-            .collect()
-    }
-}
+use crate::laplacian::Csr;
 
 /// What the solver did.
 #[derive(Debug, Clone, Copy, Default, serde::Serialize)]
@@ -89,8 +31,8 @@ fn dotv(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-fn objective(h: &SymCsr, c: &[f64], x: &[f64], tmp: &mut [f64]) -> f64 {
-    h.mul(x, tmp);
+fn objective(h: &Csr, c: &[f64], x: &[f64], tmp: &mut [f64]) -> f64 {
+    h.mul_vec(x, tmp, 1);
     0.5 * dotv(x, tmp) + dotv(c, x)
 }
 
@@ -110,7 +52,7 @@ fn project(x: &mut [f64], lo: &[f64], hi: &[f64]) {
 /// Solves the box QP to a relative projected-gradient tolerance `tol`, starting from the point of
 /// the box nearest 0. Needs `lo ≤ hi`.
 pub fn solve_box(
-    h: &SymCsr,
+    h: &Csr,
     c: &[f64],
     lo: &[f64],
     hi: &[f64],
@@ -123,7 +65,7 @@ pub fn solve_box(
     let mut g = vec![0.0; n];
     let mut tmp = vec![0.0; n];
     let grad = |x: &[f64], g: &mut [f64]| {
-        h.mul(x, g);
+        h.mul_vec(x, g, 1);
         for i in 0..n {
             g[i] += c[i];
         }
@@ -136,9 +78,9 @@ pub fn solve_box(
     }
     let mut q = objective(h, c, &x, &mut tmp);
     for outer in 0..MAX_OUTER {
-        if outer % 16 == 0 {
-            progress.check()?;
-        }
+        // Each outer iteration costs a few products with H (up to 60 in the line search), each
+        // CG iteration one: at 30k unknowns a product is ~1 ms, so both poll every time.
+        progress.check()?;
         st.outer_iterations = outer + 1;
         let pg = projected_gradient(&g, &x, lo, hi);
         let pgn = pg.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -149,11 +91,12 @@ pub fn solve_box(
         }
         // 1. Projected gradient step (Armijo along the projection arc).
         let d: Vec<f64> = pg.iter().map(|v| -v).collect();
-        h.mul(&d, &mut tmp);
+        h.mul_vec(&d, &mut tmp, 1);
         let dhd = dotv(&d, &tmp);
         let mut alpha = if dhd > 0.0 { dotv(&d, &d) / dhd } else { 1.0 };
         let mut xn = x.clone();
         for _ in 0..60 {
+            progress.check()?;
             for i in 0..n {
                 xn[i] = x[i] + alpha * d[i];
             }
@@ -179,10 +122,8 @@ pub fn solve_box(
                 break;
             }
             st.cg_iterations += 1;
-            if st.cg_iterations % 256 == 0 {
-                progress.check()?;
-            }
-            h.mul(&p, &mut tmp);
+            progress.check()?;
+            h.mul_vec(&p, &mut tmp, 1);
             let php = dotv(&p, &tmp);
             if php <= 0.0 {
                 break;
@@ -252,7 +193,7 @@ mod tests {
     }
 
     /// H = Aᵀ A + δI for a random sparse-ish A (always SPD).
-    fn random_problem(n: usize, seed: u64) -> (SymCsr, Vec<f64>, Vec<f64>, Vec<f64>) {
+    fn random_problem(n: usize, seed: u64) -> (Csr, Vec<f64>, Vec<f64>, Vec<f64>) {
         let mut r = rng(seed);
         let mut dense = vec![vec![0.0; n]; n];
         for _ in 0..2 * n {
@@ -276,13 +217,13 @@ mod tests {
         let c = (0..n).map(|_| r() * 4.0).collect();
         let lo = (0..n).map(|_| -0.1 - (r() + 0.5) * 0.5).collect();
         let hi = (0..n).map(|_| 0.1 + (r() + 0.5) * 0.5).collect();
-        (SymCsr::from_triplets(n, t), c, lo, hi)
+        (Csr::from_triplets(n, t), c, lo, hi)
     }
 
     #[test]
     fn diagonal_problem_is_the_clamped_minimiser() {
         // Separable: x_i = clamp(−c_i/h_i, lo_i, hi_i), by hand.
-        let h = SymCsr::from_triplets(3, vec![(0, 0, 2.0), (1, 1, 1.0), (2, 2, 4.0)]);
+        let h = Csr::from_triplets(3, vec![(0, 0, 2.0), (1, 1, 1.0), (2, 2, 4.0)]);
         let c = [-1.0, 3.0, -1.0];
         let (x, st) = solve_box(&h, &c, &[-1.0; 3], &[1.0; 3], 1e-12, &Progress::new()).unwrap();
         assert!(
@@ -301,7 +242,7 @@ mod tests {
             let (x, st) = solve_box(&h, &c, &lo, &hi, 1e-10, &Progress::new()).unwrap();
             assert!(st.converged, "seed {seed}: {st:?}");
             let mut g = vec![0.0; n];
-            h.mul(&x, &mut g);
+            h.mul_vec(&x, &mut g, 1);
             let gmax = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for i in 0..n {
                 g[i] += c[i];
@@ -327,7 +268,7 @@ mod tests {
         let neg: Vec<f64> = big.iter().map(|v| -v).collect();
         let (x, _) = solve_box(&h, &c, &neg, &big, 1e-12, &Progress::new()).unwrap();
         let mut g = vec![0.0; 30];
-        h.mul(&x, &mut g);
+        h.mul_vec(&x, &mut g, 1);
         let res = g.iter().zip(&c).map(|(a, b)| (a + b).abs()).fold(0.0, f64::max);
         assert!(res < 1e-8, "residual {res}");
     }
