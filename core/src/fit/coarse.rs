@@ -88,7 +88,7 @@ pub(super) fn coarse_alignment(
         let values: Vec<Point3> =
             fixed.iter().map(|&(p, v)| sub(net.points[p as usize], pos[v as usize])).collect();
         let name = |i: usize| format!("pairs[{i}] (template vertex {})", params.pairs[i].template_vertex);
-        let f = fit_rbf(centres, values, params, "coarse", "pairs", &name)?;
+        let f = fit_rbf(centres, values, params, "coarse", "pairs", &name, progress)?;
         let disp = f.eval_many(pos, progress)?;
         for (p, d) in pos.iter_mut().zip(disp) {
             *p = add(*p, d);
@@ -354,6 +354,7 @@ pub(super) fn fit_rbf(
     stage: &str,
     field: &str,
     name: &dyn Fn(usize) -> String,
+    progress: &Progress,
 ) -> Result<rbf::Rbf> {
     use rbf::Degenerate;
     // The targets matter as much as the centres: template vertices picked near a straight or flat
@@ -407,10 +408,15 @@ pub(super) fn fit_rbf(
             }
             // The seed's remedy was centres offset along the vertex normals; see
             // [`rbf::Rbf::fit_in_plane`] for why the in-plane polynomial replaces it.
-            return rbf::Rbf::fit_in_plane(&centres, &values, params.kernel, stage).map_err(|e| {
-                Error::params(field, format!("{stage} RBF centres are degenerate even in their plane: {e}"))
-            });
+            return rbf::Rbf::fit_in_plane_polled(&centres, &values, params.kernel, stage, progress).map_err(
+                |e| {
+                    Error::params(
+                        field,
+                        format!("{stage} RBF centres are degenerate even in their plane: {e}"),
+                    )
+                },
+            );
         }
     }
-    rbf::Rbf::fit(&centres, &values, params.kernel, stage)
+    rbf::Rbf::fit_polled(&centres, &values, params.kernel, stage, progress)
 }

@@ -109,11 +109,12 @@ pub(super) fn fine_dispatch(
     params: &FitParams,
     template_diag: f64,
     parents: &mut Vec<[(u32, f64); 3]>,
+    search: insert::FootSearch,
     progress: &Progress,
 ) -> Result<Fine> {
     match params.matching {
         Matching::Insert => {
-            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, progress)
+            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)
         }
         Matching::NearestVertex => fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress),
     }
@@ -131,6 +132,7 @@ fn fine_fit_inserted(
     params: &FitParams,
     template_diag: f64,
     parents: &mut Vec<[(u32, f64); 3]>,
+    search: insert::FootSearch,
     progress: &Progress,
 ) -> Result<Fine> {
     let pair_fixed = coarse.pair_fixed(&params.pairs);
@@ -141,8 +143,15 @@ fn fine_fit_inserted(
     };
     let before = tris.clone();
     let nv0 = pos.len();
-    let ins =
-        insert::insert_curve_points(pos, tris, net, &pair_fixed, params.end_snap * template_diag, progress)?;
+    let ins = insert::insert_curve_points(
+        pos,
+        tris,
+        net,
+        &pair_fixed,
+        params.end_snap * template_diag,
+        Some(search),
+        progress,
+    )?;
     for c in &ins.created_in[nv0..] {
         let (f, l) = c.ok_or_else(|| Error::Internal("inserted vertex without origin".into()))?;
         let t = before[f as usize];
@@ -156,7 +165,7 @@ fn fine_fit_inserted(
     let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
     let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
     lap(0);
-    let f = fit_rbf(centres, values, params, "fine", "curves", &name)?;
+    let f = fit_rbf(centres, values, params, "fine", "curves", &name, progress)?;
     lap(1);
     let augmented = f.in_plane();
     let disp = f.eval_many(pos, progress)?;
@@ -260,7 +269,7 @@ fn fine_fit(
         let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
         let name =
             |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
-        let f = fit_rbf(centres, values, params, "fine", "curves", &name)?;
+        let f = fit_rbf(centres, values, params, "fine", "curves", &name, progress)?;
         let augmented = f.in_plane();
         let disp = f.eval_many(pos, progress)?;
         let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();

@@ -30,7 +30,7 @@ pub fn detect(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> FlipSca
             continue; // degenerate before: no orientation to lose
         }
         // Projection of the moved points on the original plane Π (Fig. 2.9).
-        let proj: Vec<Point3> = q.iter().map(|&x| sub(x, scale(n, dot(sub(x, p[0]), n)))).collect();
+        let proj: [Point3; 3] = q.map(|x| sub(x, scale(n, dot(sub(x, p[0]), n))));
         let orient = dot(cross(sub(proj[1], proj[0]), sub(proj[2], proj[0])), n);
         let by_orient = orient <= 0.0;
         let mut counter = 0;

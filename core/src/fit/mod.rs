@@ -133,10 +133,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         // cluster where it is closest, which is no density of the curves).
         let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
         let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
+        // One closest-point search (a BVH over the approached template) for the refinement's
+        // density check and the insertion's feet; the refinement replaces it when it splits.
+        let mut search = insert::FootSearch::new(&pos, &tris)?;
         let mut refined = refine::refine_near_curves(
             &mut pos,
             &mut tris,
             &net,
+            &mut search,
             dense,
             max,
             budget,
@@ -144,8 +148,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             progress,
         )?;
         refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
-        let mut fine =
-            fine_dispatch(&mut pos, &mut tris, &net, &coarse, params, template_diag, &mut parents, progress)?;
+        let mut fine = fine_dispatch(
+            &mut pos,
+            &mut tris,
+            &net,
+            &coarse,
+            params,
+            template_diag,
+            &mut parents,
+            search,
+            progress,
+        )?;
         fine.report.approach = Some(approach);
         fine.report.approach_ms = approach_ms;
         Ok((fine, refined))
@@ -243,8 +256,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     for ((f, &r), &g) in mesh.alive_faces().collect::<Vec<_>>().into_iter().zip(&region0).zip(&group0) {
         labels[f as usize] = ((r as u64) << 32) | g as u64;
     }
+    // (A sort of the live faces' edges, not a hash lookup per vertex: ~3 % of the headline.)
+    let boundary = trimesh::boundary_vertices(mesh.pos.len(), &retri_tris);
     drop(retri_tris);
-    let boundary: Vec<bool> = (0..mesh.pos.len() as u32).map(|v| mesh.is_boundary_vertex(v)).collect();
     let fixed: Vec<bool> = (0..mesh.pos.len()).map(|v| realised.on_curve[v] || boundary[v]).collect();
     let cleaned = stages.run(progress, "cleanup", || {
         if !params.cleanup {

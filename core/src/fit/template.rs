@@ -134,15 +134,7 @@ pub fn weld_coincident(template: &mut Mesh, pairs: &mut [FitPair]) -> usize {
     // position (raw suzanne has two pairs, each with its own closed fan) would be pinched into
     // non-manifold vertices by a weld (measured: 7 flips instead of 0).
     let tris = crate::shapes::fan_triangles(&template.faces);
-    let directed: std::collections::HashSet<(u32, u32)> =
-        tris.iter().flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3]))).collect();
-    let mut on_rim = vec![false; nv];
-    for &(a, b) in &directed {
-        if !directed.contains(&(b, a)) {
-            on_rim[a as usize] = true;
-            on_rim[b as usize] = true;
-        }
-    }
+    let on_rim = super::trimesh::boundary_vertices(nv, &tris);
     for v in (0..nv).filter(|&v| used[v] && on_rim[v]) {
         let uv = template.uvs.as_ref().and_then(|u| u.get(v)).map(|t| t.map(|c| (c + 0.0).to_bits()));
         let k = first.entry((key(&template.positions[v]), uv)).or_insert(v as u32);

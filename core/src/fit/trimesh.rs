@@ -45,6 +45,31 @@ pub fn check_oriented_manifold_faces(tris: &[[u32; 3]], face_of: Option<&[usize]
     Ok(())
 }
 
+/// Vertices on a boundary edge (a directed edge whose reverse no face uses), of `nv` vertices.
+/// A sort, not a hash set: on the headline's 192k-face template the hash set cost ~60 ms.
+pub fn boundary_vertices(nv: usize, tris: &[[u32; 3]]) -> Vec<bool> {
+    // (undirected edge, direction): an edge is a boundary edge when it is used in one direction only.
+    let mut keys: Vec<(u64, bool)> = Vec::with_capacity(tris.len() * 3);
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            keys.push((((a.min(b) as u64) << 32) | a.max(b) as u64, a < b));
+        }
+    }
+    keys.sort_unstable();
+    let mut on_rim = vec![false; nv];
+    for group in keys.chunk_by(|x, y| x.0 == y.0) {
+        if group.iter().all(|e| e.1 == group[0].1) {
+            for v in [group[0].0 >> 32, group[0].0 & 0xffff_ffff] {
+                if let Some(r) = on_rim.get_mut(v as usize) {
+                    *r = true;
+                }
+            }
+        }
+    }
+    on_rim
+}
+
 #[derive(Clone)]
 pub struct TriMesh {
     pub pos: Vec<Point3>,
@@ -205,6 +230,20 @@ impl TriMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn boundary_vertices_are_those_on_one_sided_edges() {
+        // A closed tetrahedron: no boundary. Without its face [1, 2, 3]: vertices 1, 2, 3 are on
+        // the rim, apex 0 is not; vertex 4 is in no face.
+        let tet = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        assert_eq!(boundary_vertices(4, &tet), vec![false; 4]);
+        assert_eq!(boundary_vertices(5, &tet[..3]), vec![false, true, true, true, false]);
+        // The same answer as the editable mesh's per-vertex test.
+        let pos = vec![[0.0; 3]; 5];
+        let mesh = TriMesh::new(pos, tet[..3].to_vec()).unwrap();
+        let each: Vec<bool> = (0..5).map(|v| mesh.is_boundary_vertex(v)).collect();
+        assert_eq!(boundary_vertices(5, &tet[..3]), each);
+    }
 
     #[test]
     fn a_split_interior_edge_makes_four_faces_around_the_new_vertex() {

@@ -72,19 +72,25 @@ pub struct Inserted {
 
 /// Inserts every curve vertex not fixed by a user pair. `fixed` = (curve point, template vertex).
 /// Curve ends within `end_snap` (a distance) of the template boundary are inserted on the
-/// boundary. Feet follow their curve ([`walk`]). On return `pos`/`tris` are the refined template.
+/// boundary. Feet follow their curve ([`walk`]). `search` is the closest-point search on this
+/// `pos`/`tris` when the caller has one (the refinement's), else one is built. On return
+/// `pos`/`tris` are the refined template.
 pub fn insert_curve_points(
     pos: &mut Vec<Point3>,
     tris: &mut Vec<[u32; 3]>,
     net: &CurveNetwork,
     fixed: &[(u32, u32)],
     end_snap: f64,
+    search: Option<FootSearch>,
     progress: &Progress,
 ) -> Result<Inserted> {
     let n = net.points.len();
     let vf = vertex_faces(pos.len(), tris);
-    let all: Vec<u32> = (0..n as u32).collect();
-    let mut feet = feet(pos, tris, &net.points, &all)?;
+    let search = match search {
+        Some(s) => s,
+        None => FootSearch::new(pos, tris)?,
+    };
+    let mut feet = search.into_all_feet(&net.points)?;
     let on_rim = super::ends::boundary_feet(pos, tris, net, end_snap);
     for b in &on_rim {
         feet[b.point_index as usize] = (b.face, b.foot, b.distance);
@@ -300,32 +306,67 @@ impl Inserter {
     }
 }
 
+/// A curve point's foot: (template face, closest point, distance).
+pub type Foot = (u32, Point3, f64);
+
 /// Closest point of each curve point on the template: (face, point, distance), exact (a BVH over
 /// the faces). The faces around the nearest template *vertex* are not enough: on a coarse template
 /// or one in pieces, the nearest vertex can belong to another piece that passes close by (raw
 /// suzanne: a curve on the head, 0.05 from an eye whose vertices are nearer than any head vertex,
-/// got its foot on the eye, and its segments could not be made edges). `vf` is unused (the
-/// signature of [`feet_near_vertex`]). One BVH build per call: called once per fit.
-pub(crate) fn feet(
-    pos: &[Point3],
-    tris: &[[u32; 3]],
-    points: &[Point3],
-    which: &[u32],
-) -> Result<Vec<(u32, Point3, f64)>> {
-    if tris.is_empty() {
-        return Err(Error::params("template", "the template has no faces"));
+/// got its foot on the eye, and its segments could not be made edges). One BVH build per call:
+/// build a [`FootSearch`] to query one template several times.
+pub(crate) fn feet(pos: &[Point3], tris: &[[u32; 3]], points: &[Point3], which: &[u32]) -> Result<Vec<Foot>> {
+    FootSearch::new(pos, tris)?.feet(points, which)
+}
+
+/// The exact closest-point search on one template (its BVH), kept so the refinement's density
+/// check and the insertion share it: building it over the 190k faces of the headline's template
+/// costs more than the 2k queries.
+pub struct FootSearch {
+    bvh: crate::spatial::Bvh,
+    /// The feet of every curve point in order (as [`FootSearch::feet`] of all gives them), when
+    /// already found on this template.
+    all: Option<Vec<Foot>>,
+}
+
+impl FootSearch {
+    pub fn new(pos: &[Point3], tris: &[[u32; 3]]) -> Result<FootSearch> {
+        if tris.is_empty() {
+            return Err(Error::params("template", "the template has no faces"));
+        }
+        let bvh = crate::spatial::Bvh::new(pos, &crate::mesh::Faces::from_triangles(tris));
+        Ok(FootSearch { bvh, all: None })
     }
-    let bvh = crate::spatial::Bvh::new(pos, &crate::mesh::Faces::from_triangles(tris));
-    let mut out = Vec::with_capacity(which.len());
-    let mut hint = 0u32;
-    for &i in which {
-        let p = points[i as usize];
-        let (c, slot) =
-            bvh.closest_hinted(p, hint).ok_or_else(|| Error::Internal("empty template".into()))?;
-        hint = slot;
-        out.push((c.face, c.point, c.dist2.sqrt()));
+
+    /// Feet of `points[i]` for `i` in `which`, in that order. Each query starts from the previous
+    /// answer (the result does not depend on it except between exactly equidistant faces).
+    pub fn feet(&self, points: &[Point3], which: &[u32]) -> Result<Vec<Foot>> {
+        let mut out = Vec::with_capacity(which.len());
+        let mut hint = 0u32;
+        for &i in which {
+            let p = points[i as usize];
+            let (c, slot) =
+                self.bvh.closest_hinted(p, hint).ok_or_else(|| Error::Internal("empty template".into()))?;
+            hint = slot;
+            out.push((c.face, c.point, c.dist2.sqrt()));
+        }
+        Ok(out)
     }
-    Ok(out)
+
+    /// Feet of all `points` in order, found once per template (kept for [`Self::into_all_feet`]).
+    pub fn all_feet(&mut self, points: &[Point3]) -> Result<&[Foot]> {
+        let all = match self.all.take() {
+            Some(all) => all,
+            None => self.feet(points, &(0..points.len() as u32).collect::<Vec<_>>())?,
+        };
+        Ok(self.all.insert(all))
+    }
+
+    /// [`Self::all_feet`], handed over.
+    pub fn into_all_feet(mut self, points: &[Point3]) -> Result<Vec<Foot>> {
+        self.all_feet(points)?;
+        Ok(self.all.unwrap_or_default())
+    }
 }
 
 /// Closest point of each curve point near the template's nearest vertex: (face, point, distance)
@@ -481,7 +522,7 @@ mod tests {
         let mesh =
             crate::mesh::Mesh { positions: pts.clone(), curves: vec![vec![0, 1, 2]], ..Default::default() };
         let net = CurveNetwork::from_mesh(&mesh, 1e-9).unwrap();
-        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, &Progress::new()).unwrap();
+        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, None, &Progress::new()).unwrap();
         assert_eq!(ins.stats.face_splits, 1);
         assert_eq!(ins.stats.edge_splits, 1);
         assert_eq!(ins.stats.reused_vertices, 1);
@@ -553,7 +594,7 @@ mod tests {
         // The case this test is for: the bulging points' plain closest points are on the upper sheet.
         let closest = feet(&pos, &tris, &pts, &[4, 5]).unwrap();
         assert!(closest.iter().all(|f| (f.1[2] - 0.1).abs() < 1e-12));
-        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, &Progress::new()).unwrap();
+        let ins = insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, None, &Progress::new()).unwrap();
         assert_eq!(ins.stats.walked_feet, 2);
         let mut last_x = f64::NEG_INFINITY;
         for (p, &v) in ins.vertex_of_point.iter().enumerate() {
