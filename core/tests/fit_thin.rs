@@ -56,7 +56,7 @@ fn flat(level: u32, thick: f64) -> Mesh {
 }
 
 #[test]
-#[ignore = "open: thin rims fold (main: 163 flipped faces, 16 of 20 regions); see docs/benchmarks.md, "Thin shapes""]
+#[ignore = "open: thin rims fold (main: 163 flipped faces, 16 of 20 regions); see docs/benchmarks.md, 'Thin shapes'"]
 fn a_flat_template_fits_bent_sections_of_a_thin_ellipsoid() {
     let surface = flat(5, 0.04);
     let planes = sweep_planes(&surface);
