@@ -16,14 +16,15 @@
 //! `CARGO_TARGET_DIR=/work/tr-fit-unseen cargo run --release -p meshwork-core --example sweep_unseen [NAME…]`
 //! (NAME: any part of a case name; `SWEEP_DETAIL=1` also prints the flip counts by stage, the
 //! untangling, clean-up and re-triangulation reports; `SWEEP_PARAMS='{"smooth": false}'` merges
-//! parameters into every fitting case.)
+//! parameters into every fitting case; `SWEEP_SLOW=1` adds the round icosphere fitted to a
+//! flattened ellipsoid's sections, which takes minutes.)
 
 use std::f64::consts::PI;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Instant;
 
 use meshwork_core::fit::testdata::{
-    circle, disjoint_union, ellipsoid_sections, gltf_lines, ngon_sphere, obj_negative_indices,
+    bend, circle, disjoint_union, ellipsoid_sections, gltf_lines, ngon_sphere, obj_negative_indices,
     plane_sections, polylines, quarter_arcs_with_gap, section_regions, sweep_planes, tilted_wave,
     to_unit_box, with_holes, with_zero_area_face,
 };
@@ -97,6 +98,21 @@ fn sections_of(name: &str) -> (Mesh, Mesh, usize) {
     let planes = sweep_planes(&fixed);
     let expected = section_regions(&fixed, &planes);
     (plane_sections(&fixed, &planes), raw_unit, expected)
+}
+
+/// An icosphere of radius 0.5 centred at (0.5, 0.5, 0.5) squashed to 1 × 0.6 × `thick`.
+fn flatten(m: &mut Mesh, thick: f64) {
+    for p in &mut m.positions {
+        *p = [p[0] + 0.5, 0.5 + 0.6 * p[1], 0.5 + thick * p[2]];
+    }
+}
+
+/// The flattened ellipsoid 1 × 0.6 × `thick` (a fine icosphere) and the sweep's planes on it.
+fn flat_ellipsoid(thick: f64) -> (Mesh, Vec<(Point3, f64)>) {
+    let mut s = icosphere(5, 0.5);
+    flatten(&mut s, thick);
+    let planes = sweep_planes(&s);
+    (s, planes)
 }
 
 fn sphere_sections(per_quadrant: usize) -> Mesh {
@@ -234,6 +250,44 @@ fn cases() -> Vec<Case> {
         json!({}),
         Expect::Fit(None),
     ));
+    // Thin shapes: the two sheets of a flattened ellipsoid are closer than the template's edges
+    // are long, and the sections run over its rim from one sheet to the other.
+    // The curves are bent (`testdata::bend`, a smooth map the template does not know).
+    for (thick, level, round, bent) in [
+        (0.04, 4, false, false),
+        (0.04, 4, false, true),
+        (0.04, 3, false, true),
+        (0.1, 3, false, true),
+        (0.04, 3, true, true),
+    ] {
+        // The round template blows up (1,280 → 255k faces, minutes): run it on request only.
+        if round && std::env::var("SWEEP_SLOW").is_err() {
+            continue;
+        }
+        let (surface, planes) = flat_ellipsoid(thick);
+        let regions = section_regions(&surface, &planes);
+        let what = if round { "round icosphere" } else { "flat icosphere" };
+        let how = if bent { ", bent" } else { "" };
+        out.push(case(
+            &format!("{what} {level} vs sections of ellipsoid 1×0.6×{thick}{how} (auto)"),
+            move || {
+                let (surface, planes) = flat_ellipsoid(thick);
+                let mut t = icosphere(level, 0.5);
+                if !round {
+                    flatten(&mut t, thick);
+                }
+                let mut c = plane_sections(&surface, &planes);
+                if bent {
+                    for p in &mut c.positions {
+                        *p = bend(*p, 1.0);
+                    }
+                }
+                Ok(vec![t, c])
+            },
+            json!({}),
+            Expect::Fit(Some(regions)),
+        ));
+    }
     out.push(case(
         "spot in mm far from origin vs own sections",
         || {
@@ -453,6 +507,9 @@ fn cases() -> Vec<Case> {
         Expect::Error(&["polylines"]),
     ));
 
+    // ---- Session 7: new failure classes ----
+    out.extend(session7_cases());
+
     // ---- Pairs ----
     let p = |v: u32, x: Point3| json!({"template_vertex": v, "curve_point": x});
     out.push(case(
@@ -496,6 +553,301 @@ fn cases() -> Vec<Case> {
         || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
         json!({"pairs": [p(0, [1.4, 0.0, 0.0]), {"template_vertex": -1, "curve_point": [0, 0, 0]}]}),
         Expect::Error(&["template_vertex"]),
+    ));
+    out
+}
+
+/// The polylines of `m` as point lists.
+fn lines_of(m: &Mesh) -> Vec<Vec<Point3>> {
+    m.curves.iter().map(|l| l.iter().map(|&v| m.positions[v as usize]).collect()).collect()
+}
+
+/// `m` with every face turned over.
+fn reversed(m: &Mesh) -> Mesh {
+    let tris: Vec<[u32; 3]> = m.faces.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect();
+    Mesh::from_triangles(m.positions.clone(), &tris)
+}
+
+/// Radius of the bumpy sphere at direction `d` (unit): 1 + 0.02·sin(3x + 2y + z) (the hand-drawn
+/// curves' surface; 2 % of the radius).
+fn bumpy(d: Point3) -> Point3 {
+    let r = 1.0 + 0.02 * (3.0 * d[0] + 2.0 * d[1] + d[2]).sin();
+    [d[0] * r, d[1] * r, d[2] * r]
+}
+
+fn session7_cases() -> Vec<Case> {
+    use serde_json::json;
+    let mut out = Vec::new();
+    let gc = |n: usize, ph: [f64; 3]| meshwork_core::fit::testdata::great_circles(1.0, n, ph);
+    out.push(case(
+        "equator drawn twice (other sampling)",
+        move || {
+            let mut l = gc(48, [0.0; 3]);
+            l.push(circle(O, X, Y, 1.0, 37, 0.03));
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "every polyline also reversed",
+        || {
+            let mut l = lines_of(&sphere_sections(6));
+            let rev: Vec<Vec<Point3>> = l.iter().map(|x| x.iter().rev().copied().collect()).collect();
+            l.extend(rev);
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "a polyline retracing itself",
+        || {
+            let mut l = lines_of(&sphere_sections(6));
+            let back: Vec<Point3> = l[0].iter().rev().take(l[0].len() / 2).copied().collect();
+            l[0].extend(back.into_iter().skip(1));
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "hand-drawn: curves on a 2% bumpy sphere",
+        move || {
+            let l: Vec<Vec<Point3>> =
+                gc(40, [0.0; 3]).into_iter().map(|c| c.into_iter().map(bumpy).collect()).collect();
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "hand-drawn: each curve its own 1.5% wobble",
+        move || {
+            let l: Vec<Vec<Point3>> = gc(40, [0.02, 0.05, 0.09])
+                .into_iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let n = c.len();
+                    c.into_iter()
+                        .enumerate()
+                        .map(|(k, p)| {
+                            let t = std::f64::consts::TAU * k as f64 / (n - 1) as f64;
+                            let r = 1.0 + 0.015 * (3.0 * t + i as f64).sin();
+                            [p[0] * r, p[1] * r, p[2] * r]
+                        })
+                        .collect()
+                })
+                .collect();
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "one 90-degree chord among short segments",
+        || {
+            let mut l = lines_of(&sphere_sections(12));
+            // The first quarter of the first polyline (between two junctions) as one segment.
+            let q = 12;
+            let first = l[0][0];
+            l[0].drain(1..q);
+            assert!(meshwork_core::geometry::dist(first, l[0][0]) == 0.0);
+            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "curves past an open template's rim",
+        || {
+            let ico = icosphere(3, 1.0);
+            let tris: Vec<[u32; 3]> = ico
+                .faces
+                .triangles()
+                .into_iter()
+                .filter(|t| t.iter().all(|&v| ico.positions[v as usize][2] > -0.3))
+                .collect();
+            Ok(vec![Mesh::from_triangles(ico.positions.clone(), &tris), sphere_sections(6)])
+        },
+        json!({}),
+        // The lower halves of the meridians are 1.1 below the rim: named, not stretched to.
+        Expect::Error(&["curve 1", "max_curve_distance"]),
+    ));
+    out.push(case(
+        "inside-out template",
+        || Ok(vec![reversed(&icosphere(3, 1.0)), sphere_sections(6)]),
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "inside-out template, no alignment",
+        || Ok(vec![reversed(&icosphere(3, 1.0)), sphere_sections(6)]),
+        json!({"alignment": "none"}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "second component inside out",
+        || {
+            let mut far = reversed(&icosphere(2, 1.0));
+            for p in &mut far.positions {
+                p[0] += 6.0;
+            }
+            Ok(vec![disjoint_union(&icosphere(3, 1.0), &far), sphere_sections(6)])
+        },
+        json!({"alignment": "none"}),
+        Expect::Fit(Some(9)),
+    ));
+    out.push(case(
+        "tiny stray triangle 100 away, auto",
+        || {
+            let mut t = icosphere(3, 1.0);
+            let n = t.positions.len() as u32;
+            t.positions.extend_from_slice(&[[100.0, 0.0, 0.0], [100.01, 0.0, 0.0], [100.0, 0.01, 0.0]]);
+            t.faces.push(&[n, n + 1, n + 2], 0);
+            Ok(vec![t, sphere_sections(6)])
+        },
+        json!({}),
+        Expect::Fit(Some(9)),
+    ));
+    out.push(case(
+        "template with a fin (non-manifold edge)",
+        || {
+            let mut t = icosphere(2, 1.0);
+            let f = t.faces.triangles()[7];
+            t.positions.push([2.0, 2.0, 2.0]);
+            let n = t.positions.len() as u32 - 1;
+            t.faces.push(&[f[0], f[1], n], 0);
+            Ok(vec![t, sphere_sections(6)])
+        },
+        json!({}),
+        Expect::Error(&["template edge", "320"]),
+    ));
+    out.push(case(
+        "template face repeating a vertex",
+        || {
+            let mut t = icosphere(3, 1.0);
+            t.faces.push(&[3, 3, 5], 0);
+            Ok(vec![t, sphere_sections(6)])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "curves as PLY edges",
+        || {
+            let c = sphere_sections(6);
+            let mut s = format!(
+                "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
+                c.positions.len()
+            );
+            let segs: Vec<[u32; 2]> = c.curves.iter().flat_map(|l| l.windows(2).map(|w| [w[0], w[1]])).collect();
+            s += &format!("element edge {}\nproperty int vertex1\nproperty int vertex2\nend_header\n", segs.len());
+            for p in &c.positions {
+                s += &format!("{} {} {}\n", p[0], p[1], p[2]);
+            }
+            for e in &segs {
+                s += &format!("{} {}\n", e[0], e[1]);
+            }
+            Ok(vec![icosphere(3, 1.0), read_as(s.as_bytes(), "c.ply")?])
+        },
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "cylinder, curves through its vertices",
+        || {
+            let cyl = meshwork_core::fit::testdata::open_cylinder(32, 9, 1.0, 2.0);
+            let at = |i: usize, j: usize| cyl.positions[j * 32 + i % 32];
+            let mut l: Vec<Vec<Point3>> = vec![(0..=32).map(|i| at(i, 4)).collect()];
+            for i in [0, 8, 16, 24] {
+                l.push((0..9).map(|j| at(i, j)).collect());
+            }
+            Ok(vec![cyl, polylines(&l)])
+        },
+        json!({"alignment": "none"}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "cylinder, curves along its rims",
+        || {
+            let cyl = meshwork_core::fit::testdata::open_cylinder(32, 9, 1.0, 2.0);
+            let at = |i: usize, j: usize| cyl.positions[j * 32 + i % 32];
+            let mut l: Vec<Vec<Point3>> = vec![(0..=32).map(|i| at(i, 0)).collect()];
+            l.push((0..=32).map(|i| at(i, 8)).collect());
+            for i in [3, 11, 19, 27] {
+                l.push((0..9).map(|j| at(i, j)).collect());
+            }
+            Ok(vec![cyl, polylines(&l)])
+        },
+        json!({"alignment": "none"}),
+        Expect::Fit(Some(4)),
+    ));
+    out.push(case(
+        "figure-8 crossing itself (no shared vertex)",
+        || {
+            let n = 64;
+            let l: Vec<Point3> = (0..=n)
+                .map(|k| {
+                    let t = std::f64::consts::TAU * (k as f64 + 0.37) / n as f64;
+                    let d = [t.sin(), t.sin() * t.cos(), 0.7];
+                    let r = norm(d);
+                    [d[0] / r, d[1] / r, d[2] / r]
+                })
+                .collect();
+            Ok(vec![icosphere(3, 1.0), polylines(&[l])])
+        },
+        json!({}),
+        Expect::Fit(Some(3)),
+    ));
+    for (label, s, o) in [("spot scaled 1e-4", 1e-4, 0.0), ("spot size 1 at offset 1e6", 1.0, 1e6)] {
+        out.push(case(
+            label,
+            move || {
+                let (c, _, _) = sections_of("spot");
+                let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
+                to_unit_box(&mut t);
+                let mut c = c;
+                for m in [&mut t, &mut c] {
+                    for p in &mut m.positions {
+                        *p = [p[0] * s + o, p[1] * s - o, p[2] * s + o];
+                    }
+                }
+                Ok(vec![t, c])
+            },
+            json!({}),
+            Expect::Fit(None),
+        ));
+    }
+    for name in ["cow", "fandisk", "homer", "rocker-arm"] {
+        out.push(case(
+            &format!("{name}-raw vs own sections"),
+            move || {
+                let (c, raw, _) = sections_of(name);
+                Ok(vec![raw, c])
+            },
+            json!({"alignment": "none"}),
+            Expect::Fit(None),
+        ));
+    }
+    out.push(case(
+        "icosphere vs sections of fandisk (auto)",
+        || {
+            let (c, _, _) = sections_of("fandisk");
+            let mut t = icosphere(3, 0.5);
+            for p in &mut t.positions {
+                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
+            }
+            Ok(vec![t, c])
+        },
+        json!({}),
+        Expect::Fit(None),
+    ));
+    out.push(case(
+        "dense template (20k faces), 4-point octants",
+        || Ok(vec![icosphere(5, 1.0), ellipsoid_sections(AXES, 1)]),
+        json!({}),
+        Expect::Fit(Some(8)),
     ));
     out
 }
@@ -547,7 +899,16 @@ fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
             chain_pts.iter().map(|&q| norm(sub(p, q))).fold(f64::INFINITY, f64::min)
         })
         .fold(0.0, f64::max);
-    if worst > 1e-9 * cdiag && r["network"]["near_duplicates_merged"] == 0 && r["network"]["ends_merged"] == 0
+    // A curve given twice has its points merged into the other copy's vertices, by at most the
+    // network's reported `junction_max_gap`.
+    let overlap_gap = if r["network"]["overlap_points_joined"].as_u64().unwrap_or(0) > 0 {
+        r["network"]["junction_max_gap"].as_f64().unwrap_or(0.0)
+    } else {
+        0.0
+    };
+    if worst > (1e-9 * cdiag).max(overlap_gap * (1.0 + 1e-9))
+        && r["network"]["near_duplicates_merged"] == 0
+        && r["network"]["ends_merged"] == 0
     {
         bad.push(format!("curve vertex {worst:.2e} from the output chains"));
     }
@@ -654,6 +1015,9 @@ fn main() {
                     }
                 }
                 if std::env::var("SWEEP_DETAIL").is_ok() {
+                    let mut alignment = r["alignment"].clone();
+                    alignment["candidates"] = serde_json::Value::Null;
+                    eprintln!("  alignment {alignment}; fine {}; stages {}", r["fine"], r["stages"]);
                     eprintln!(
                         "  refine {}; flips after fine {} / before smoothing {} / final {}; untangle {}; cleanup {}; retriangulation {}",
                         r["refine"],
@@ -664,6 +1028,7 @@ fn main() {
                         r["cleanup"],
                         r["retriangulation"]
                     );
+                    eprintln!("  stages {}; fine {}", r["stages"], r["fine"]);
                 }
                 let status = match (bad.is_empty(), r["retriangulation"]["failed_pieces"].as_u64()) {
                     (true, Some(n)) if n > 0 => format!("ok ({n} segments between unjoined pieces)"),

@@ -71,6 +71,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Coincident vertices are welded (unwelded seams), then vertices in no face are removed
     // (both counted in the report); pairs are renumbered.
     let (mut template, mut weld_pairs) = (template, params.pairs.clone());
+    // Faces with a repeated corner (collapsed edges) are mended or removed, and counted.
+    let repeated_corners = template::drop_repeated_corners(&mut template);
     let welded = template::weld_coincident(&mut template, &mut weld_pairs);
     let (template, renumbered_pairs, unreferenced) = template::drop_unreferenced(template, &weld_pairs)?;
     let renumbered;
@@ -103,7 +105,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             return Err(Error::params("template", "the template has no faces"));
         }
         // Fails early, naming the face, on a non-manifold or inconsistently oriented template.
-        trimesh::check_oriented_manifold(&tris)?;
+        let face_of: Vec<usize> = (0..template.faces.len())
+            .flat_map(|i| std::iter::repeat_n(i, template.faces.arity(i).saturating_sub(2)))
+            .collect();
+        trimesh::check_oriented_manifold_faces(&tris, Some(&face_of))?;
         Ok(tris)
     })?;
     let template_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
@@ -491,6 +496,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
     report["template_vertices_welded"] = welded.into();
+    report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();

@@ -60,6 +60,53 @@ pub fn drop_unreferenced(
     Ok((template, Some(pairs), removed.len()))
 }
 
+/// What [`drop_repeated_corners`] changed (the report's `template_repeated_corners`).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct RepeatedCorners {
+    /// Corners removed because they repeat the corner before them (a quad `a a b c` is the
+    /// triangle `a b c`).
+    pub corners_removed: usize,
+    /// Faces removed: fewer than three distinct corners left, or a vertex repeated elsewhere in
+    /// the face (a pinched polygon). Their indices, first ten.
+    pub faces_removed: usize,
+    pub first_faces_removed: Vec<usize>,
+}
+
+/// Removes the corners of template faces that repeat the corner before them (cyclically) and
+/// the faces left with fewer than three corners or with another repeat. Exporters write such
+/// faces for collapsed edges (`f 3 3 5`); they have no area and no orientation, and a repeated
+/// vertex makes no triangle of a mesh, so the fit would have to refuse the template. Counted in
+/// the report, never silent.
+pub fn drop_repeated_corners(template: &mut Mesh) -> RepeatedCorners {
+    let mut r = RepeatedCorners::default();
+    let bad = |f: &[u32]| (0..f.len()).any(|k| f[k] == f[(k + 1) % f.len()]) || f.len() < 3;
+    if !template.faces.iter().any(|f| bad(f) || (1..f.len()).any(|k| f[..k].contains(&f[k]))) {
+        return r;
+    }
+    let mut faces = crate::mesh::Faces::with_capacity(template.faces.len(), template.faces.indices().len());
+    let mut corners: Vec<u32> = Vec::new();
+    for (i, f) in template.faces.iter().enumerate() {
+        corners.clear();
+        for k in 0..f.len() {
+            if f[k] != f[(k + 1) % f.len()] {
+                corners.push(f[k]);
+            }
+        }
+        r.corners_removed += f.len() - corners.len();
+        let pinched = (1..corners.len()).any(|k| corners[..k].contains(&corners[k]));
+        if corners.len() < 3 || pinched {
+            r.faces_removed += 1;
+            if r.first_faces_removed.len() < 10 {
+                r.first_faces_removed.push(i);
+            }
+            continue;
+        }
+        faces.push(&corners, template.faces.group(i));
+    }
+    template.faces = faces;
+    r
+}
+
 /// Welds template vertices at exactly the same position (−0 = +0), so that a raw mesh exported
 /// as separate patches or with unwelded seams (the Utah teapot's 32 patches: 403 duplicates) is
 /// one surface: a curve crossing a seam can then be a chain of edges, which no re-triangulation
@@ -153,6 +200,30 @@ mod tests {
         let mut f = Mesh::new(pos, Faces::from_triangles(&[[0, 1, 2], [3, 5, 4]]));
         assert_eq!(weld_coincident(&mut f, &mut []), 0);
         assert_eq!(f.faces.get(1), &[3, 5, 4]);
+    }
+
+    /// Hand-made faces: a triangle with a doubled corner, a quad whose last corner repeats its
+    /// first (a triangle), a face of two distinct corners and a pinched pentagon.
+    #[test]
+    fn repeated_corners_are_removed_and_counted() {
+        let pos = vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0]];
+        let mut faces = Faces::new();
+        faces.push(&[0, 1, 2], 0);
+        faces.push(&[1, 1, 3, 2], 1);
+        faces.push(&[4, 3, 1, 4], 0);
+        faces.push(&[0, 0, 1, 1], 0);
+        faces.push(&[0, 1, 3, 1, 4], 0);
+        let mut m = Mesh::new(pos, faces);
+        let r = drop_repeated_corners(&mut m);
+        assert_eq!((r.corners_removed, r.faces_removed), (4, 2));
+        assert_eq!(r.first_faces_removed, vec![3, 4]);
+        assert_eq!(m.faces.len(), 3);
+        assert_eq!((m.faces.get(1), m.faces.group(1)), (&[1, 3, 2][..], 1));
+        assert_eq!(m.faces.get(2), &[4, 3, 1]);
+        // Nothing to do: the same faces object.
+        let before = m.faces.clone();
+        assert_eq!(drop_repeated_corners(&mut m).faces_removed, 0);
+        assert_eq!(m.faces, before);
     }
 
     #[test]

@@ -14,10 +14,17 @@ pub type EdgeSet = crate::hash::IntSet<(u32, u32)>;
 /// The check [`TriMesh::new`] makes, without building the mesh: no face repeats a vertex and no
 /// directed edge is used twice (a sort, not a hash map: this runs on every template).
 pub fn check_oriented_manifold(tris: &[[u32; 3]]) -> Result<()> {
+    check_oriented_manifold_faces(tris, None)
+}
+
+/// [`check_oriented_manifold`] naming the input face of each triangle (`face_of[t]`, for a
+/// template of quads and n-gons triangulated by fans) instead of the triangle.
+pub fn check_oriented_manifold_faces(tris: &[[u32; 3]], face_of: Option<&[usize]>) -> Result<()> {
+    let name = |t: u32| face_of.and_then(|f| f.get(t as usize).copied()).unwrap_or(t as usize);
     let mut keys: Vec<(u64, u32)> = Vec::with_capacity(tris.len() * 3);
     for (fi, t) in tris.iter().enumerate() {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            return Err(Error::Topology(format!("template face {fi} repeats a vertex {t:?}")));
+            return Err(Error::Topology(format!("template face {} repeats a vertex {t:?}", name(fi as u32))));
         }
         for k in 0..3 {
             keys.push((((t[k] as u64) << 32) | t[(k + 1) % 3] as u64, fi as u32));
@@ -30,7 +37,8 @@ pub fn check_oriented_manifold(tris: &[[u32; 3]]) -> Result<()> {
             return Err(Error::Topology(format!(
                 "template edge ({a}, {b}) is used in the same direction by faces {} and {}: \
                  the template is not an oriented manifold (run the repair job first)",
-                w[0].1, w[1].1
+                name(w[0].1),
+                name(w[1].1)
             )));
         }
     }

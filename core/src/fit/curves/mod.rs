@@ -89,6 +89,9 @@ pub struct NetworkStats {
     /// Consecutive points merged by `merge_tolerance`, and the largest distance merged.
     pub near_duplicates_merged: usize,
     pub near_duplicate_max_distance: f64,
+    /// Points of a curve given twice (other sampling) put into the other copy's segments or
+    /// merged into its vertices (step 3a of the module doc).
+    pub overlap_points_joined: usize,
     /// Curve ends joined to another polyline's segment (split there) or vertex (merged).
     pub t_junctions: usize,
     pub ends_merged: usize,
@@ -182,6 +185,7 @@ impl CurveNetwork {
         let mut b = Builder { points: weld.points, polylines, stats };
         b.merge_near_duplicates(opt.merge_tolerance);
         if opt.junction_tolerance > 0.0 {
+            b.merge_overlaps();
             b.join_ends(opt.junction_tolerance);
             b.insert_crossings(opt.junction_tolerance);
         }

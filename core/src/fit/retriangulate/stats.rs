@@ -18,6 +18,9 @@ pub struct RetriStats {
     /// split instead, and the vertices that added.
     pub split_segments: usize,
     pub split_vertices: usize,
+    /// Of those, strips split because they bend too much to be re-filled through one plane
+    /// (faces more than 35° from the strip's mean normal).
+    pub curved_strips: usize,
     /// Segments (or their rest after a partial walk) realised by the Dijkstra-and-project fallback
     /// (§3.2), taken only when moving its path onto the segment turns no face over.
     pub fallback_segments: usize,

@@ -108,12 +108,18 @@ impl Work<'_> {
             moved = super::super::uvs::record(mesh, end, target);
             mesh.pos[end as usize] = target;
         }
-        if !retriangulate(mesh, cur, end, faces, crossed) {
+        let curved = strip_is_curved(mesh, cut, faces, crossed);
+        if curved {
+            self.stats.curved_strips += 1;
+        }
+        if curved || !retriangulate(mesh, cur, end, faces, crossed) {
             // No valid re-triangulation of the strip with the same face count (it wraps around a
             // vertex, or an ear would need an existing edge): split every edge the segment crosses
             // instead, at the crossing (Li's insertion; +2 faces per crossed edge). The walk
             // already proved the strip connects cur to end.
-            self.stats.walk_fail_fill += 1;
+            if !curved {
+                self.stats.walk_fail_fill += 1;
+            }
             let n0 = chain.len();
             if !split_strip(mesh, cut, crossed, &mut self.on_curve, &mut self.added, chain) {
                 if chain.len() == n0 {
@@ -132,6 +138,42 @@ impl Work<'_> {
         }
         true
     }
+}
+
+/// The cosine of the largest angle a strip face may make with the strip's mean normal and still
+/// be re-filled flat (35°).
+const FLAT_STRIP_COS: f64 = 0.82;
+
+/// Is the walked strip too curved to be re-filled through one plane? The ear cutting works in
+/// the plane of the strip's mean normal and puts the straight edge u–end in: on a strip bent by
+/// more than ~35° whose crossings lie deeper under that edge than the crossed edges are long (a
+/// sparse curve over a dense template: one 90° segment crosses a hundred faces of an icosphere of
+/// 20k faces) the edge is a chord far under the surface and the re-filled faces fold over it
+/// (measured: 141 folds and 7 s of untangling). Such strips are split at their crossings
+/// instead, which keeps the chain on the surface. Short strips over a crease (dense curves)
+/// keep the re-filling.
+fn strip_is_curved(mesh: &TriMesh, cut: &Cut, faces: &[u32], crossed: &[(u32, u32)]) -> bool {
+    let mut mean = [0.0; 3];
+    for &f in faces {
+        mean = add(mean, mesh.face_normal(f));
+    }
+    let mean = normalize(mean);
+    // (Zero-area faces have no normal and no say.)
+    let bent = faces.iter().any(|&f| {
+        let n = normalize(mesh.face_normal(f));
+        n != [0.0; 3] && dot(n, mean) < FLAT_STRIP_COS
+    });
+    if !bent || crossed.is_empty() {
+        return false;
+    }
+    let mut edge_len = 0.0;
+    let mut deepest: f64 = 0.0;
+    for &(l, r) in crossed {
+        edge_len += norm(sub(mesh.pos[l as usize], mesh.pos[r as usize]));
+        let x = crossing(mesh, cut, l, r).0;
+        deepest = deepest.max(norm(sub(x, cut.on_line(x))));
+    }
+    deepest > 0.5 * edge_len / crossed.len() as f64
 }
 
 /// The cutting plane of u–w: through both, containing their mean vertex normal. None for a

@@ -56,6 +56,8 @@ pub(super) enum Role {
     Normal(usize),
     Uv(usize),
     FaceIndices,
+    /// `vertex1` / `vertex2` of an `edge` element (loose edges, as Blender writes them).
+    EdgeEnd(usize),
     Skip,
 }
 
@@ -200,6 +202,8 @@ fn role_of(element: &str, name: &str, is_list: bool) -> Role {
         ("vertex", "u" | "s" | "texture_u" | "texture_s", false) => Role::Uv(0),
         ("vertex", "v" | "t" | "texture_v" | "texture_t", false) => Role::Uv(1),
         ("face", "vertex_indices" | "vertex_index", true) => Role::FaceIndices,
+        ("edge", "vertex1", false) => Role::EdgeEnd(0),
+        ("edge", "vertex2", false) => Role::EdgeEnd(1),
         _ => Role::Skip,
     }
 }

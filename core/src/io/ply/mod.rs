@@ -2,8 +2,9 @@
 //!
 //! The header is parsed into [`Element`]s; the body is then read element by element through one
 //! [`Body`] interface over the ascii token stream or the binary cursor, so both encodings share the
-//! logic that maps properties to roles (x/y/z, normals, texture coordinates, face indices) and skips
-//! everything else, including unknown elements and list properties.
+//! logic that maps properties to roles (x/y/z, normals, texture coordinates, face indices, the
+//! `vertex1`/`vertex2` of loose edges, read as two-point curves) and skips everything else,
+//! including unknown elements and list properties.
 //!
 //! Declared counts are never trusted for allocation: capacity is capped by what the remaining
 //! bytes can hold, and a binary body shorter than the header's counts demand is refused before
@@ -31,6 +32,8 @@ struct Out {
     normals: Vec<[f64; 3]>,
     uvs: Vec<[f64; 2]>,
     faces: Faces,
+    /// Loose edges (`element edge`), as two-point polylines.
+    curves: Vec<Vec<u32>>,
     /// Vertex count declared in the header (face indices are checked against it).
     nv: u64,
     skipped: Vec<String>,
@@ -96,6 +99,7 @@ fn read_elements(h: &Header, body: &mut dyn Body, out: &mut Out) -> Result<()> {
         match el.name.as_str() {
             "vertex" => read_vertices(el, body, out)?,
             "face" if el.has(Role::FaceIndices) => read_faces(el, body, out)?,
+            "edge" if el.has(Role::EdgeEnd(0)) && el.has(Role::EdgeEnd(1)) => read_edges(el, body, out)?,
             _ => {
                 skip_element(el, body)?;
                 if el.count > 0 {
@@ -221,6 +225,42 @@ fn read_faces(el: &Element, body: &mut dyn Body, out: &mut Out) -> Result<()> {
     Ok(())
 }
 
+/// Loose edges: `vertex1`, `vertex2` (any integer type; other properties skipped), each a
+/// two-point curve. An index out of range is an error naming the edge.
+fn read_edges(el: &Element, body: &mut dyn Body, out: &mut Out) -> Result<()> {
+    let cap = capacity(el.count, el.min_binary_size() as usize, body);
+    out.curves.reserve(cap);
+    for ei in 0..el.count {
+        let at = body.location();
+        let mut ends = [0u32; 2];
+        for prop in &el.props {
+            if let Some(ct) = prop.list {
+                let k = list_len(body, ct)?;
+                body.skip(prop.ty, k)?;
+                continue;
+            }
+            match prop.role {
+                Role::EdgeEnd(k) => {
+                    let v = body.int(prop.ty)?;
+                    if v < 0 || v as u64 >= out.nv {
+                        return Err(Error::InvalidMesh {
+                            location: at,
+                            message: format!(
+                                "edge {ei}: vertex index {v} out of range ({} vertices)",
+                                out.nv
+                            ),
+                        });
+                    }
+                    ends[k] = v as u32;
+                }
+                _ => body.skip(prop.ty, 1)?,
+            }
+        }
+        out.curves.push(ends.to_vec());
+    }
+    Ok(())
+}
+
 fn skip_element(el: &Element, body: &mut dyn Body) -> Result<()> {
     if el.props.is_empty() {
         return Ok(()); // nothing to read, however large the count
@@ -244,7 +284,7 @@ fn finish(h: Header, out: Out) -> Result<Loaded> {
         let unused: Vec<&str> = el
             .props
             .iter()
-            .filter(|p| p.role == Role::Skip && (el.name == "vertex" || el.name == "face"))
+            .filter(|p| p.role == Role::Skip && matches!(el.name.as_str(), "vertex" | "face" | "edge"))
             .map(|p| p.name.as_str())
             .collect();
         if !unused.is_empty() {
@@ -256,6 +296,7 @@ fn finish(h: Header, out: Out) -> Result<Loaded> {
         uvs: (out.uvs.len() == n).then_some(out.uvs),
         positions: out.positions,
         faces: out.faces,
+        curves: out.curves,
         ..Default::default()
     };
     Ok(Loaded { mesh, format: Format::Ply, warnings })
@@ -286,6 +327,22 @@ mod tests {
         assert_eq!(l.mesh.positions, TETRA.to_vec());
         assert_eq!(l.mesh.faces, Faces::from_triangles(&TETRA_F));
         assert!(l.warnings.iter().any(|w| w.contains("2 `material`")), "{:?}", l.warnings);
+    }
+
+    /// Loose edges (Blender's `element edge`) become two-point curves, with the edge's other
+    /// properties skipped; an index past the vertices names the edge.
+    #[test]
+    fn edges_are_read_as_two_point_curves() {
+        let src = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                   property float z\nelement edge 2\nproperty int vertex1\nproperty uchar red\n\
+                   property int vertex2\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 9 1\n1 9 2\n";
+        let l = read_b(src.as_bytes()).unwrap();
+        assert_eq!(l.mesh.curves, vec![vec![0, 1], vec![1, 2]]);
+        assert_eq!(l.mesh.faces.len(), 0);
+        assert!(l.warnings.iter().any(|w| w.contains("red")), "{:?}", l.warnings);
+        let bad = src.replace("1 9 2\n", "1 9 3\n");
+        let e = read_b(bad.as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("edge 1") && e.contains("line 16"), "{e}");
     }
 
     fn binary(big: bool, idx_ty: &str, cnt_ty: &str) -> Vec<u8> {
