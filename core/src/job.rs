@@ -38,6 +38,17 @@ impl Progress {
         Self::default()
     }
 
+    /// Runs the polled form of a function without a job around it (tests, benchmarks, callers
+    /// with nothing to cancel), for functions whose only error is [`Progress::check`]'s: a fresh
+    /// `Progress` has no cancel, no deadline and no cancel-at-check, so that error cannot happen.
+    /// One place for that argument instead of an `expect` beside every unpolled wrapper.
+    pub fn unpolled<T>(f: impl FnOnce(&Progress) -> Result<T>) -> T {
+        match f(&Progress::new()) {
+            Ok(v) => v,
+            Err(e) => unreachable!("a fresh Progress never stops a job, yet the call failed: {e}"),
+        }
+    }
+
     /// After `deadline`, [`Progress::check`] fails with [`Error::TimedOut`].
     pub fn set_deadline(&self, deadline: Instant) {
         *lock(&self.inner.deadline) = Some(deadline);

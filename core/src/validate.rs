@@ -111,8 +111,7 @@ pub fn run(mesh: &Mesh, params: &ValidateParams, progress: &Progress) -> Result<
 
 /// The report without timings (for tests and benchmarks; jobs use [`analyze_polled`]).
 pub fn analyze(mesh: &Mesh) -> Report {
-    analyze_polled(mesh, &Progress::new())
-        .expect("analyze_polled fails only through progress.check(), and a fresh Progress is never cancelled")
+    Progress::unpolled(|p| analyze_polled(mesh, p))
 }
 
 /// The report without timings, polling `progress` between its passes but leaving its stage
@@ -314,9 +313,7 @@ pub fn distinct_count(f: &[u32]) -> usize {
 /// Indices of faces whose vertex set equals that of an earlier face (winding and start ignored),
 /// ascending.
 pub fn duplicate_faces(faces: &crate::mesh::Faces) -> Vec<usize> {
-    duplicate_faces_polled(faces, &Progress::new()).expect(
-        "duplicate_faces_polled fails only through progress.check(), and a fresh Progress is never cancelled",
-    )
+    Progress::unpolled(|p| duplicate_faces_polled(faces, p))
 }
 
 /// Faces between two polls of [`duplicate_faces_polled`]: a few ms of hashing.

@@ -14,26 +14,18 @@
 //! Fixed by walked feet in the approach, used where the walks from both sides of a point agree
 //! (`fit/approach.rs`, `walked_feet`): 0 / 0 flips, 0.73 %.
 
-use meshwork_core::fit::testdata::{
-    bend, crossing_pairs, plane_sections, sweep_planes, thin_network, to_unit_box,
-};
+mod fit_support;
+
+use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, sweep_planes, thin_network};
 use meshwork_core::fit::{run, FitParams};
 use meshwork_core::geometry::{dot, triangle_cross, Aabb};
-use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::Mesh;
-use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
 use meshwork_core::spatial::Bvh;
 use meshwork_core::Progress;
 
 fn load(name: &str) -> Mesh {
-    let path = format!("{}/../../shared/meshes/{name}.obj", env!("CARGO_MANIFEST_DIR"));
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut m = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
-    to_unit_box(&mut m);
-    m
+    fit_support::load_repaired(name)
 }
 
 #[test]

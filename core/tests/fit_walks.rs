@@ -9,24 +9,16 @@
 //! chain". On main before the route fallback: spot 99.28 % of segments, 19 of 22 regions;
 //! fandisk 99.86 %, 15 of 16.
 
-use meshwork_core::fit::testdata::{
-    bend, plane_sections, section_regions, sweep_planes, thin_network, to_unit_box,
-};
+mod fit_support;
+
+use meshwork_core::fit::testdata::{bend, plane_sections, section_regions, sweep_planes, thin_network};
 use meshwork_core::fit::{run, FitParams};
-use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::Mesh;
-use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::shapes::subdivide_midpoint;
 use meshwork_core::Progress;
 
 fn load(name: &str) -> Mesh {
-    let path = format!("{}/../../shared/meshes/{name}.obj", env!("CARGO_MANIFEST_DIR"));
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut m = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
-    to_unit_box(&mut m);
-    m
+    fit_support::load_repaired(name)
 }
 
 fn fit_auto(name: &str) {

@@ -288,31 +288,9 @@ fn dedup_centres(centres: &mut Vec<Point3>, values: &mut Vec<Point3>) {
 mod tests {
     use super::*;
 
-    /// Two parallel unit squares, z = 0 (facing −z) and z = 0.1 (facing +z), 8 × 8 cells each: a
-    /// thin plate whose sheets are closer than the curve may be to either.
+    /// The insertion tests' two-sheet plate, with its vertex-face lists.
     fn plate() -> (Vec<Point3>, Vec<[u32; 3]>, Vec<Vec<u32>>) {
-        let n = 8;
-        let mut pos = Vec::new();
-        let mut tris = Vec::new();
-        for (sheet, z) in [0.0, 0.1].into_iter().enumerate() {
-            let base = pos.len() as u32;
-            for j in 0..=n {
-                for i in 0..=n {
-                    pos.push([i as f64 / n as f64, j as f64 / n as f64, z]);
-                }
-            }
-            let id = |i: u32, j: u32| base + j * (n + 1) + i;
-            for j in 0..n {
-                for i in 0..n {
-                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                    if sheet == 0 {
-                        tris.extend([[a, c, b], [a, d, c]]);
-                    } else {
-                        tris.extend([[a, b, c], [a, c, d]]);
-                    }
-                }
-            }
-        }
+        let (pos, tris) = crate::fit::insert::tests::two_sheet_plate();
         let mut vf = vec![Vec::new(); pos.len()];
         for (f, t) in tris.iter().enumerate() {
             for &v in t {

@@ -31,8 +31,7 @@ impl Csr {
     /// The `n × n` matrix summing the `(i, j, v)` entries (duplicates added up, a zero diagonal
     /// entry stored where none is given).
     pub fn from_triplets(n: usize, t: Vec<(u32, u32, f64)>) -> Csr {
-        Csr::from_triplets_polled(n, t, &Progress::new())
-            .expect("from_triplets_polled fails only through progress.check(), and a fresh Progress is never cancelled")
+        Progress::unpolled(|p| Csr::from_triplets_polled(n, t, p))
     }
 
     /// [`Csr::from_triplets`], polling `progress`. The entries are bucketed by row (a counting

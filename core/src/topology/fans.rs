@@ -87,8 +87,7 @@ impl Topology {
 
     /// Kind of every vertex (see [`VertexKind`]).
     pub fn vertex_kinds(&self) -> Vec<VertexKind> {
-        self.vertex_kinds_polled(&Progress::new())
-            .expect("vertex_kinds_polled fails only through progress.check(), and a fresh Progress is never cancelled")
+        Progress::unpolled(|p| self.vertex_kinds_polled(p))
     }
 
     /// [`Topology::vertex_kinds`], polling `progress` every [`POLL_ITEMS`] edges and vertices.

@@ -111,9 +111,7 @@ impl Topology {
     /// Topology of a face list over `n_vertices` vertices. Indices ≥ `n_vertices` (which
     /// [`Mesh::check`] rejects) do not panic: the vertex count grows to cover them.
     pub fn from_faces(faces: &Faces, n_vertices: usize) -> Topology {
-        Topology::from_faces_polled(faces, n_vertices, &Progress::new()).expect(
-            "from_faces_polled fails only through progress.check(), and a fresh Progress is never cancelled",
-        )
+        Progress::unpolled(|p| Topology::from_faces_polled(faces, n_vertices, p))
     }
 
     /// [`Topology::from_faces`], polling `progress` (see [`Topology::new_polled`]).

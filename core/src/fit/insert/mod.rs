@@ -508,7 +508,7 @@ fn split_edge(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -549,13 +549,10 @@ mod tests {
         }
     }
 
-    /// Two sheets 0.1 apart (z = 0 and z = 0.1, unit squares split into 8 × 8 × 2 triangles, not
-    /// connected) and a curve along x over the lower one at z = 0.03, except two points that
-    /// bulge to z = 0.07: closer to the upper sheet (0.03) than to the lower (0.07). Hand truth:
-    /// the curve runs along the lower sheet, so every curve vertex is inserted there (z = 0), in
-    /// x order. Plain closest points put the two bulging points on the upper sheet.
-    #[test]
-    fn feet_follow_their_curve_instead_of_jumping_to_a_nearby_sheet() {
+    /// Two parallel unit squares, z = 0 (facing −z) and z = 0.1 (facing +z), 8 × 8 cells of two
+    /// triangles each, not connected: a thin plate whose sheets are closer than a curve may be to
+    /// either (also the approach's walk tests).
+    pub(crate) fn two_sheet_plate() -> (Vec<Point3>, Vec<[u32; 3]>) {
         let n = 8;
         let mut pos = Vec::new();
         let mut tris = Vec::new();
@@ -579,6 +576,17 @@ mod tests {
                 }
             }
         }
+        (pos, tris)
+    }
+
+    /// Two sheets 0.1 apart (z = 0 and z = 0.1, unit squares split into 8 × 8 × 2 triangles, not
+    /// connected) and a curve along x over the lower one at z = 0.03, except two points that
+    /// bulge to z = 0.07: closer to the upper sheet (0.03) than to the lower (0.07). Hand truth:
+    /// the curve runs along the lower sheet, so every curve vertex is inserted there (z = 0), in
+    /// x order. Plain closest points put the two bulging points on the upper sheet.
+    #[test]
+    fn feet_follow_their_curve_instead_of_jumping_to_a_nearby_sheet() {
+        let (mut pos, mut tris) = two_sheet_plate();
         let pts: Vec<Point3> = (1..=9)
             .map(|k| {
                 let z = if k == 5 || k == 6 { 0.07 } else { 0.03 };
