@@ -26,6 +26,7 @@ pub mod correspond;
 pub mod curves;
 pub mod degenerate;
 pub mod ends;
+pub mod field_refine;
 mod fine;
 pub mod flips;
 pub mod groups;
@@ -125,8 +126,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let pair_fixed = coarse.pair_fixed(&params.pairs);
         let levels = params.approach_levels as usize;
         let limit = params.max_curve_distance * template_diag;
-        let approach =
-            approach::approach(&mut pos, &tris, &net, &pair_fixed, params.kernel, levels, limit, progress)?;
+        let approach = approach::approach(
+            &mut pos,
+            &mut tris,
+            &mut parents,
+            &net,
+            &pair_fixed,
+            params.kernel,
+            levels,
+            limit,
+            progress,
+        )?;
         let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
         // Faces of the approached template under dense curves are split, so no face has to hold
         // many curve vertices (after the approach: feet of curves still far from a coarse surface

@@ -167,7 +167,7 @@ fn feet_per_face(
 
 /// The faces to split 1→4: `over` plus every face that would otherwise have two or more split
 /// edges (the closure that leaves only single-edge bisections to keep the mesh conforming).
-fn red_closure(tris: &[[u32; 3]], over: &[u32]) -> Vec<u32> {
+pub(super) fn red_closure(tris: &[[u32; 3]], over: &[u32]) -> Vec<u32> {
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     let mut faces_of_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
     for (f, t) in tris.iter().enumerate() {
