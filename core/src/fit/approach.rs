@@ -38,6 +38,9 @@ pub struct ApproachReport {
     /// Curve points per level whose walked foot was used instead of their closest point (user
     /// pairs only, [`walked_feet`]).
     pub walked_feet: Vec<usize>,
+    /// Sampled curve points per level whose foot was moved from a sheet to the rim, because they
+    /// lie between the template's two sheets near its rim ([`super::thin`]).
+    pub rim_feet: Vec<usize>,
 }
 
 /// Sample counts per level: each level uses 4× the centres of the previous one, the last at most
@@ -55,7 +58,9 @@ fn level_sizes(n: usize, levels: usize) -> Vec<usize> {
 
 /// Moves `pos` towards the curves in up to `levels` levels. `fixed` template vertices (user pairs
 /// already on their curve points) are centres with zero displacement at every level. Nothing moves
-/// when a curve vertex is farther than `max_distance` from the surface.
+/// when a curve vertex is farther than `max_distance` from the surface. With `rim_feet`, feet of
+/// points between two sheets of a thin part are moved to its rim ([`super::thin`]).
+#[allow(clippy::too_many_arguments)]
 pub fn approach(
     pos: &mut [Point3],
     tris: &[[u32; 3]],
@@ -64,6 +69,7 @@ pub fn approach(
     kernel: Kernel,
     levels: usize,
     max_distance: f64,
+    rim_feet: bool,
     progress: &Progress,
 ) -> Result<ApproachReport> {
     let mut report = ApproachReport::default();
@@ -127,6 +133,10 @@ pub fn approach(
         } else {
             feet_of(pos, &sample)?
         };
+        let mut feet = feet;
+        if rim_feet {
+            report.rim_feet.push(super::thin::rim_feet(pos, tris, &vf, &net.points, &sample, &mut feet));
+        }
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());

@@ -40,6 +40,7 @@ pub mod retriangulate;
 pub mod smooth;
 pub mod template;
 pub mod testdata;
+pub mod thin;
 pub mod trimesh;
 pub mod untangle;
 pub mod uvs;
@@ -125,8 +126,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let pair_fixed = coarse.pair_fixed(&params.pairs);
         let levels = params.approach_levels as usize;
         let limit = params.max_curve_distance * template_diag;
-        let approach =
-            approach::approach(&mut pos, &tris, &net, &pair_fixed, params.kernel, levels, limit, progress)?;
+        let approach = approach::approach(
+            &mut pos,
+            &tris,
+            &net,
+            &pair_fixed,
+            params.kernel,
+            levels,
+            limit,
+            params.thin_rim_feet,
+            progress,
+        )?;
         let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
         // Faces of the approached template under dense curves are split, so no face has to hold
         // many curve vertices (after the approach: feet of curves still far from a coarse surface
@@ -167,6 +177,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Folds the fine deformation left (faces turned against the surface before it) are undone by
     // local edge flips and ring-mean moves of non-curve vertices.
     let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), std::mem::take(&mut tris))?;
+    // The stages after the fine one stop (too-large, naming the stage) past this many faces.
+    let face_base = crate::shapes::fan_triangles(&template.faces).len()
+        + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+    mesh.set_face_limit((params.max_face_growth * face_base as f64).min(usize::MAX as f64 / 2.0) as usize);
+    mesh.check_growth("fine")?;
     let untangle_fine = stages.run(progress, "untangle_fine", || {
         let reference = report::vertex_normals(&pos, &mesh.tris);
         let mut fixed = vec![false; pos.len()];
@@ -205,6 +220,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
+    mesh.check_growth("retriangulate")?;
     let fine_parents = parents.len();
     parents.extend_from_slice(&realised.added);
     // Vertices split into crossed edges take the reference normal of their edge.
@@ -235,6 +251,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             progress,
         )
     })?;
+    mesh.check_growth("untangle_retriangulated")?;
     // Vertices those splits added: after the re-triangulation's in every per-vertex array.
     for a in &untangle_retri.added {
         parents.push(*a);
@@ -498,6 +515,21 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;
+    if std::env::var("FIT_FACE_GROWTH_TMP").is_ok() {
+        eprintln!(
+            "FACE_GROWTH {} {} {:.3}",
+            mesh.peak_faces(),
+            face_base,
+            mesh.peak_faces() as f64 / face_base as f64
+        );
+    }
+    // The guard's measure: the most faces the mesh had after the fine stage, over its base.
+    report["face_growth"] = serde_json::json!({
+        "peak_faces": mesh.peak_faces(),
+        "base": face_base,
+        "ratio": mesh.peak_faces() as f64 / face_base.max(1) as f64,
+        "limit": params.max_face_growth,
+    });
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })
