@@ -49,10 +49,6 @@ pub fn shapes() -> Vec<Case> {
         (0.1, 3, false, true),
         (0.04, 3, true, true),
     ] {
-        // The round template blows up (1,280 → 255k faces, minutes): run it on request only.
-        if round && std::env::var("SWEEP_SLOW").is_err() {
-            continue;
-        }
         let (surface, planes) = flat_ellipsoid(thick);
         let regions = section_regions(&surface, &planes);
         let what = if round { "round icosphere" } else { "flat icosphere" };
@@ -74,7 +70,14 @@ pub fn shapes() -> Vec<Case> {
                 Ok(vec![t, c])
             },
             json!({}),
-            Expect::Fit(Some(regions)),
+            // The round template cannot follow a thin target: without the face guard it ran for
+            // 200–470 s to 255k–361k faces, 8 of 20 regions and ~1,400 flipped faces; the guard
+            // (`max_face_growth`) stops it at the re-triangulation in seconds, naming the stage.
+            if round {
+                Expect::Error(&["max_face_growth", "exceeds the limit", "retriangulate"])
+            } else {
+                Expect::Fit(Some(regions))
+            },
         ));
     }
     out.push(case(

@@ -515,14 +515,6 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;
-    if std::env::var("FIT_FACE_GROWTH_TMP").is_ok() {
-        eprintln!(
-            "FACE_GROWTH {} {} {:.3}",
-            mesh.peak_faces(),
-            face_base,
-            mesh.peak_faces() as f64 / face_base as f64
-        );
-    }
     // The guard's measure: the most faces the mesh had after the fine stage, over its base.
     report["face_growth"] = serde_json::json!({
         "peak_faces": mesh.peak_faces(),
