@@ -6,7 +6,9 @@
 //! point so far away that its squared distance overflows.
 
 use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
-use meshwork_core::fit::testdata::{circle, ellipsoid_sections, great_circles, gltf_strips_with_nodes, polylines};
+use meshwork_core::fit::testdata::{
+    circle, ellipsoid_sections, gltf_strips_with_nodes, great_circles, polylines,
+};
 use meshwork_core::geometry::{dist, Aabb};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::job::{self, JobKind, Output};
@@ -121,7 +123,8 @@ fn gltf_strips_under_node_transforms() {
     let want = ellipsoid_sections(AXES, 6);
     let lines = lines_of(&want);
     let bytes = gltf_strips_with_nodes(&lines);
-    let c = read(&bytes, &ReadOptions { name_hint: Some("c.gltf".into()), ..Default::default() }).unwrap().mesh;
+    let c =
+        read(&bytes, &ReadOptions { name_hint: Some("c.gltf".into()), ..Default::default() }).unwrap().mesh;
     // The reader applied the transforms: every polyline comes back where it was.
     assert_eq!(c.curves.len(), 3);
     for (l, w) in c.curves.iter().zip(&lines) {
@@ -149,8 +152,14 @@ fn gltf_strips_under_node_transforms() {
 #[test]
 fn a_pair_point_at_1e300_is_named() {
     let p = |v: u32, x: Point3| json!({"template_vertex": v, "curve_point": x});
-    let pairs = json!([p(0, [1.4, 0.0, 0.0]), p(5, [0.0, 1.15, 0.0]), p(9, [0.0, 0.0, 0.9]), p(11, [1e300, 0.0, 0.0])]);
-    let e = fit(icosphere(2, 1.0), ellipsoid_sections(AXES, 6), json!({ "pairs": pairs })).err().expect("error");
+    let pairs = json!([
+        p(0, [1.4, 0.0, 0.0]),
+        p(5, [0.0, 1.15, 0.0]),
+        p(9, [0.0, 0.0, 0.9]),
+        p(11, [1e300, 0.0, 0.0])
+    ]);
+    let e =
+        fit(icosphere(2, 1.0), ellipsoid_sections(AXES, 6), json!({ "pairs": pairs })).err().expect("error");
     let text = e.to_string();
     assert!(text.contains("pairs[3].curve_point") && text.contains("nearest curve vertex"), "{text}");
 }
