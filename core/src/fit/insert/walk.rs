@@ -17,7 +17,9 @@
 //! passes near. Walks start afresh at every anchor (feature point, curve end, user pair), whose
 //! own closest point is kept.
 
+use crate::error::Result;
 use crate::geometry::dist;
+use crate::job::Progress;
 use crate::mesh::Point3;
 use crate::spatial::closest_on_triangle;
 
@@ -35,12 +37,17 @@ pub fn walk_feet(
     net: &CurveNetwork,
     feet: &mut [(u32, Point3, f64)],
     anchor: &[bool],
-) -> usize {
+    progress: &Progress,
+) -> Result<usize> {
     let mut changed = 0;
     let mut done = vec![false; net.points.len()];
     let mut seen = SeenFaces::new(tris.len());
+    let mut walks = 0;
     for line in &net.polylines {
         for w in line.windows(2) {
+            // A walk searches up to a ball of faces: a poll every 256 walks is a few ms.
+            walks += 1;
+            progress.check_every(walks, 256)?;
             let (p0, p) = (w[0] as usize, w[1] as usize);
             if anchor[p] || done[p] {
                 continue;
@@ -59,7 +66,7 @@ pub fn walk_feet(
             }
         }
     }
-    changed
+    Ok(changed)
 }
 
 /// Component of each face, numbered from 0 in face order (faces sharing a vertex are connected,
