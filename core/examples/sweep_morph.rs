@@ -17,7 +17,7 @@ use meshwork_core::geometry::{normalize, Aabb};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Faces, Mesh, Point3};
-use meshwork_core::shapes::{fan_triangles, icosphere, octahedron as octa, tetrahedron as tetra};
+use meshwork_core::shapes::{cube, fan_triangles, icosphere, octahedron as octa, tetrahedron as tetra};
 use meshwork_core::spatial::Bvh;
 use serde_json::{json, Value};
 
@@ -66,26 +66,6 @@ fn cube_like(levels: u32) -> Mesh {
         let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
         [p[0] / m, p[1] / m, p[2] / m]
     })
-}
-
-/// The 12-triangle cube: 8 vertices, outward.
-fn cube12() -> Mesh {
-    let pos: Vec<Point3> = (0..8)
-        .map(|i| {
-            [
-                if i & 1 == 0 { -1.0 } else { 1.0 },
-                if i & 2 == 0 { -1.0 } else { 1.0 },
-                if i & 4 == 0 { -1.0 } else { 1.0 },
-            ]
-        })
-        .collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let mut tris = Vec::new();
-    for q in quads {
-        tris.push([q[0], q[1], q[2]]);
-        tris.push([q[0], q[2], q[3]]);
-    }
-    Mesh::from_triangles(pos, &tris)
 }
 
 /// Latitude–longitude sphere (pole fans, thin triangles near the poles): nu·(nv−1)·2 faces.
@@ -213,9 +193,9 @@ fn cases() -> Vec<Case> {
         plain.clone(),
     ));
     v.push(case("cube-icosphere", vec![cube_like(4), icosphere(3, 1.0)], plain.clone()));
-    v.push(case("cube12-homer", vec![cube12(), shared("homer")], plain.clone()));
+    v.push(case("cube12-homer", vec![cube(), shared("homer")], plain.clone()));
     v.push(case("tetra-octa", vec![tetra(), octa()], plain.clone()));
-    v.push(case("tetra-cube12", vec![tetra(), cube12()], plain.clone()));
+    v.push(case("tetra-cube12", vec![tetra(), cube()], plain.clone()));
     v.push(case("uvsphere200k-homer", vec![uv_sphere(320, 314), shared("homer")], plain.clone()));
     v.push(case("ico500-ell100k", vec![icosphere(3, 1.0), ellipsoid(7, [1.5, 1.0, 0.7])], plain.clone()));
     v.push(case("homer-self", vec![shared("homer"), shared("homer")], plain.clone()));

@@ -194,6 +194,19 @@ pub fn tetrahedron() -> Mesh {
     Mesh::from_triangles(pos, &[[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
 }
 
+/// The cube [−1, 1]³ as 12 triangles on its 8 corners (corner `i` has x, y, z = ±1 by bits 0, 1,
+/// 2 of `i`), outward-oriented.
+pub fn cube() -> Mesh {
+    let pos: Vec<Point3> = (0..8)
+        .map(|i| {
+            [(i & 1) as f64 * 2.0 - 1.0, ((i >> 1) & 1) as f64 * 2.0 - 1.0, ((i >> 2) & 1) as f64 * 2.0 - 1.0]
+        })
+        .collect();
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let tris: Vec<[u32; 3]> = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    Mesh::from_triangles(pos, &tris)
+}
+
 /// Regular octahedron with vertices ±eᵢ (on the unit sphere), outward-oriented.
 pub fn octahedron() -> Mesh {
     let pos = vec![
@@ -288,6 +301,11 @@ mod tests {
         assert!((signed_volume(&tetrahedron().positions, &tetrahedron().faces) - 8.0 / 3.0).abs() < 1e-12);
         // Octahedron |x|+|y|+|z| ≤ 1: 4/3, positive (outward).
         assert!((signed_volume(&octahedron().positions, &octahedron().faces) - 4.0 / 3.0).abs() < 1e-12);
+        // Cube [−1, 1]³: volume 8, outward; 8 corners, 12 triangles, each corner at (±1, ±1, ±1).
+        let c = cube();
+        assert_eq!((c.vertex_count(), c.face_count()), (8, 12));
+        assert!(c.positions.iter().all(|p| p.iter().all(|x| x.abs() == 1.0)));
+        assert!((signed_volume(&c.positions, &c.faces) - 8.0).abs() < 1e-12);
         let h = hemisphere(10, 24);
         assert_eq!(h.vertex_count(), 1 + 10 * 24);
         assert_eq!(h.face_count(), 24 + 2 * 9 * 24);

@@ -167,14 +167,14 @@ fn analyze_with(
     })?;
     let diag = bbox.map(|b| b.diagonal()).unwrap_or(0.0);
 
-    let topo = stages.run(progress, "topology", || Ok(Topology::new(mesh)))?;
+    let topo = stages.run(progress, "topology", || Topology::new_polled(mesh, progress))?;
 
     let FaceScan { arity: face_arity, out_of_range, degenerate, area, duplicates } =
         stages.run(progress, "faces", || scan_faces(mesh, diag, progress))?;
     ex.degenerate_faces = degenerate.iter().take(max_examples).copied().collect();
     ex.duplicate_faces = duplicates.iter().take(max_examples).copied().collect();
 
-    let kinds = stages.run(progress, "vertices", || Ok(topo.vertex_kinds()))?;
+    let kinds = stages.run(progress, "vertices", || topo.vertex_kinds_polled(progress))?;
     let count = |k: VertexKind| kinds.iter().filter(|&&x| x == k).count();
     let list = |k: VertexKind| -> Vec<u32> {
         (0..kinds.len() as u32).filter(|&v| kinds[v as usize] == k).take(max_examples).collect()

@@ -145,6 +145,8 @@ fn report_stages_poll_inside() {
     // Seven passes (geometry, topology, faces, vertices, edges, components, boundary loops).
     assert!(stage_polls(&s, "validate_output") >= 7, "{s:?}");
     assert!(stage_polls(&s, "validate_input") >= 7, "{s:?}");
+    // outward: after the topology, after the components, then per 65,536 edges and faces.
+    assert!(stage_polls(&s, "outward") >= 4, "{s:?}");
     let (_, s) = polls(JobKind::Morph, &[icosphere(2, 1.0), icosphere(3, 1.0)], &json!({"frames": 2}));
     // Per input: the metamesh's vertices and the input's vertices and centroids, in chunks.
     assert!(stage_polls(&s, "report") >= 4, "{s:?}");
@@ -160,6 +162,10 @@ fn long_passes_poll_in_proportion_to_their_work() {
     let big = icosphere(6, 1.0); // 81,920 triangles
     let (_, s) = polls(JobKind::Validate, &[big], &json!({}));
     assert!(stage_polls(&s, "faces") >= 2 + 3, "{s:?}");
+    // The topology build (3 between passes + one per 32,768 of the 40,962 vertices) and the vertex
+    // kinds (one per 32,768 of the 122,880 edges and of the vertices).
+    assert!(stage_polls(&s, "topology") >= 3 + 2, "{s:?}");
+    assert!(stage_polls(&s, "vertices") >= 4 + 2, "{s:?}");
 
     // highlight `fair`: at least one poll per CG iteration and per outer QP iteration.
     let params = json!({"method": "highlight", "region_all": true, "iterations": 3, "light_normal": [0, 0, 1],

@@ -7,7 +7,7 @@ use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::metamesh::{self, Layer};
 use meshwork_core::morph::overlay_degenerate;
-use meshwork_core::shapes::{icosphere, octahedron as octa, tetrahedron as tetra};
+use meshwork_core::shapes::{cube, icosphere, octahedron as octa, tetrahedron as tetra};
 use meshwork_core::spatial::closest_on_triangle;
 use serde_json::json;
 
@@ -90,21 +90,7 @@ fn check_covers(o: &Layer, oc: &Mesh) {
 /// not the barycentric transfer that only samples the target at 4 points).
 #[test]
 fn coarse_polyhedra_morph_reproduces_both_ends() {
-    let cube = {
-        let pos: Vec<Point3> = (0..8)
-            .map(|i| {
-                [
-                    if i & 1 == 0 { -1.0 } else { 1.0 },
-                    if i & 2 == 0 { -1.0 } else { 1.0 },
-                    if i & 4 == 0 { -1.0 } else { 1.0 },
-                ]
-            })
-            .collect();
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let tris: Vec<[u32; 3]> =
-            quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-        Mesh::from_triangles(pos, &tris)
-    };
+    let cube = cube();
     for (a, b) in [(tetra(), octa()), (tetra(), cube.clone())] {
         let o = job::run(
             JobKind::Morph,

@@ -20,9 +20,9 @@ pub struct Csr {
 }
 
 /// Triplets moved between two polls of [`Csr::from_triplets_polled`] (a few ms).
-const TRIPLETS_PER_POLL: usize = 1 << 20;
+const TRIPLETS_PER_POLL: usize = 1 << 18;
 /// Rows sorted between two polls of [`Csr::from_triplets_polled`].
-const ROWS_PER_POLL: usize = 4096;
+const ROWS_PER_POLL: usize = 512;
 
 /// Rows below this count run serially (rayon's overhead dominates small products).
 const PAR_ROWS: usize = 20_000;
@@ -41,7 +41,8 @@ impl Csr {
     pub fn from_triplets_polled(n: usize, t: Vec<(u32, u32, f64)>, progress: &Progress) -> Result<Csr> {
         // Each row's diagonal first, so that it is stored even when no triplet names it.
         let mut start = vec![0usize; n + 1];
-        for &(i, _, _) in &t {
+        for (k, &(i, _, _)) in t.iter().enumerate() {
+            progress.check_every(k, 4 * TRIPLETS_PER_POLL)?;
             start[i as usize + 1] += 1;
         }
         for i in 0..n {
@@ -216,10 +217,10 @@ mod tests {
         let p = Progress::new();
         let a = Csr::from_triplets_polled(n, t.clone(), &p).unwrap();
         assert_eq!(a.nnz(), 2 * n);
-        // One poll at triplet 0, one per ROWS_PER_POLL rows.
-        assert_eq!(p.checks(), 1 + 3);
+        // One poll at triplet 0 of each of the two passes over them, one per ROWS_PER_POLL rows.
+        assert_eq!(p.checks(), 2 + 3);
         let p = Progress::new();
-        p.cancel_at_check(3);
+        p.cancel_at_check(4);
         assert!(matches!(Csr::from_triplets_polled(n, t, &p), Err(crate::Error::Cancelled)));
     }
 }

@@ -331,7 +331,7 @@ fn close_and_compact(r: &mut Repairing, params: &RepairParams, input: &validate:
         if !r.dirty && input.components == 1 && input.volume.is_some_and(|v| v > 0.0) {
             r.skip("outward", "input is one closed component with positive volume");
         } else {
-            r.step("outward", "outward", |m, _| Ok(orient::outward(m)), |o| o.components_flipped > 0)?;
+            r.step("outward", "outward", orient::outward, |o| o.components_flipped > 0)?;
         }
     }
     if params.remove_unreferenced {

@@ -2,7 +2,9 @@
 
 use serde::Serialize;
 
+use crate::error::Result;
 use crate::geometry::{cross, dot};
+use crate::job::Progress;
 use crate::mesh::{Faces, Mesh};
 use crate::topology::{Connectivity, Topology};
 
@@ -104,13 +106,18 @@ pub struct OutwardReport {
     pub open_components: usize,
 }
 
+/// Edges or faces visited between two polls of [`outward`] (a few ms).
+const POLL_ITEMS: usize = 65_536;
+
 /// Flips closed, consistently oriented components whose signed volume is negative.
-pub fn outward(mesh: &mut Mesh) -> OutwardReport {
-    let topo = Topology::new(mesh);
+pub fn outward(mesh: &mut Mesh, progress: &Progress) -> Result<OutwardReport> {
+    let topo = Topology::new_polled(mesh, progress)?;
     let comps = topo.components(Connectivity::SharedEdge);
+    progress.check()?;
     let nc = comps.count();
     let mut closed = vec![true; nc];
     for e in 0..topo.edge_count() as u32 {
+        progress.check_every(e as usize, POLL_ITEMS)?;
         let u = topo.edge_uses(e);
         if u.len() != 2 || u[0].forward == u[1].forward {
             closed[comps.face_label[u[0].face as usize] as usize] = false;
@@ -119,6 +126,7 @@ pub fn outward(mesh: &mut Mesh) -> OutwardReport {
     // Signed volume per component.
     let mut vol = vec![0.0; nc];
     for f in 0..topo.face_count() {
+        progress.check_every(f, POLL_ITEMS)?;
         vol[comps.face_label[f] as usize] += face_volume(&mesh.positions, topo.face_vertices(f as u32));
     }
     let flip: Vec<bool> = (0..topo.face_count())
@@ -130,7 +138,7 @@ pub fn outward(mesh: &mut Mesh) -> OutwardReport {
     let components_flipped = (0..nc).filter(|&c| closed[c] && vol[c] < 0.0).count();
     flip_faces(&mut mesh.faces, &flip);
     let closed_components = closed.iter().filter(|&&b| b).count();
-    OutwardReport { closed_components, components_flipped, open_components: nc - closed_components }
+    Ok(OutwardReport { closed_components, components_flipped, open_components: nc - closed_components })
 }
 
 #[cfg(test)]
@@ -155,7 +163,7 @@ mod tests {
         assert!(analyze(&m).inconsistent_orientation > 0);
         let r = make_consistent(&mut m);
         assert_eq!(r.conflicting_edges, 0);
-        let o = outward(&mut m);
+        let o = outward(&mut m, &Progress::new()).unwrap();
         assert_eq!(o.closed_components, 1);
         let a = analyze(&m);
         assert_eq!(a.inconsistent_orientation, 0);

@@ -1,7 +1,9 @@
 //! Fans around a vertex (see the module docs of [`super`]): the per-vertex count used by repair and
 //! the all-vertex [`VertexKind`] classification used by validation.
 
-use super::{find, union, Topology, NONE};
+use super::{find, union, Topology, NONE, POLL_ITEMS};
+use crate::error::Result;
+use crate::job::Progress;
 
 /// What the faces around a vertex look like (see the module docs for fans and pinches).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -85,6 +87,12 @@ impl Topology {
 
     /// Kind of every vertex (see [`VertexKind`]).
     pub fn vertex_kinds(&self) -> Vec<VertexKind> {
+        self.vertex_kinds_polled(&Progress::new())
+            .expect("vertex_kinds_polled fails only through progress.check(), and a fresh Progress is never cancelled")
+    }
+
+    /// [`Topology::vertex_kinds`], polling `progress` every [`POLL_ITEMS`] edges and vertices.
+    pub fn vertex_kinds_polled(&self, progress: &Progress) -> Result<Vec<VertexKind>> {
         // One global union-find over corners: the two corners at each end of a manifold edge are
         // in the same fan. Unions only join corners of the same vertex, and the smaller index wins,
         // so every class's root is one of that vertex's corners. (Same result as [`Topology::fans`]
@@ -92,6 +100,7 @@ impl Topology {
         let nc = self.corner_vertex.len();
         let mut parent: Vec<u32> = (0..nc as u32).collect();
         for e in 0..self.edges.len() {
+            progress.check_every(e, POLL_ITEMS)?;
             let (lo, hi) = (self.edge_offsets[e] as usize, self.edge_offsets[e + 1] as usize);
             if hi - lo != 2 {
                 continue;
@@ -114,6 +123,7 @@ impl Topology {
         let mut class_open = vec![false; nc];
         let mut kinds = Vec::with_capacity(self.n_vertices);
         for v in 0..self.n_vertices {
+            progress.check_every(v, POLL_ITEMS)?;
             let corners = self.vertex_corners.row(v);
             if corners.is_empty() {
                 kinds.push(VertexKind::Unreferenced);
@@ -151,7 +161,7 @@ impl Topology {
                 VertexKind::NonManifold
             });
         }
-        kinds
+        Ok(kinds)
     }
 }
 

@@ -49,6 +49,23 @@ pub fn relative_distance_brute(a: &Mesh, b: &Mesh) -> f64 {
         / bbox_diag(&a.positions)
 }
 
+/// The Khronos glTF validator's report on `file` (`tests/gltf-validator/validate.mjs`; needs Node.js
+/// and `npm ci --prefix tests/gltf-validator`).
+pub fn khronos_report(file: &Path) -> serde_json::Value {
+    let res = std::process::Command::new("node")
+        .arg(root().join("tests/gltf-validator/validate.mjs"))
+        .arg(file)
+        .output()
+        .expect("node (install Node.js or set MESHWORK_SKIP_VALIDATOR=1)");
+    serde_json::from_slice(&res.stdout).unwrap_or_else(|_| {
+        panic!(
+            "validator output: {} {}",
+            String::from_utf8_lossy(&res.stdout),
+            String::from_utf8_lossy(&res.stderr)
+        )
+    })
+}
+
 /// Area of the spherical triangle (a, b, c) on the unit sphere (Van Oosterom–Strackee), signed.
 pub fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
     let num = dot(a, cross(b, c));
