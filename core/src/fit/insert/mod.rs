@@ -539,6 +539,34 @@ pub(crate) mod tests {
         assert_eq!(p.checks(), 3);
     }
 
+    /// The insertion's polls, counted by hand: its search's BVH build (as counted above), one per
+    /// 256 walks (a closed run of 1,000 segments: walks 256, 512, 768) and one per 1,024 queued
+    /// points (1,000 points: k = 0). The code before made only the last one: the build and the
+    /// walks ran without a poll.
+    #[test]
+    fn the_insertion_polls_in_its_search_walks_and_queue() {
+        let m = crate::shapes::icosphere(5, 1.0);
+        let n = 1000;
+        let pts: Vec<Point3> = (0..n)
+            .map(|k| {
+                let t = std::f64::consts::TAU * (k as f64 + 0.3) / n as f64;
+                [1.01 * t.cos(), 1.01 * t.sin(), 0.05]
+            })
+            .collect();
+        let mut ring: Vec<u32> = (0..n as u32).collect();
+        ring.push(0);
+        let curves = crate::mesh::Mesh { positions: pts, curves: vec![ring], ..Default::default() };
+        let net = CurveNetwork::from_mesh(&curves, 1e-9).unwrap();
+        assert_eq!(net.points.len(), n);
+        assert_eq!(net.polylines.iter().map(|l| l.len() - 1).sum::<usize>(), n, "the case: 1,000 segments");
+        let bvh = Progress::new();
+        crate::spatial::Bvh::new_polled(&m.positions, &m.faces, &bvh).unwrap();
+        let (mut pos, mut tris) = (m.positions.clone(), m.faces.triangles());
+        let p = Progress::new();
+        insert_curve_points(&mut pos, &mut tris, &net, &[], 0.0, None, &p).unwrap();
+        assert_eq!(p.checks(), bvh.checks() + 3 + 1);
+    }
+
     #[test]
     fn splits_face_edge_and_reuses_vertex() {
         // Unit square of two triangles; curve points: one near the centre of face 1, one over the
