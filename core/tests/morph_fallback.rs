@@ -5,7 +5,7 @@
 
 use std::f64::consts::PI;
 
-use meshwork_core::geometry::{cross, dot, norm, sub};
+use meshwork_core::geometry::{cross, norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings, SphereMethod};

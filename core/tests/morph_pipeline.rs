@@ -3,7 +3,7 @@
 //! points for the end frames, an analytic ellipsoid, the Khronos validator for the GLB.
 
 use meshwork_core::error::Error;
-use meshwork_core::geometry::{dot, norm, sub};
+use meshwork_core::geometry::{norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings};
