@@ -154,7 +154,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
         // One closest-point search (a BVH over the approached template) for the refinement's
         // density check and the insertion's feet; the refinement replaces it when it splits.
-        let mut search = insert::FootSearch::new(&pos, &tris)?;
+        let mut search = insert::FootSearch::new_polled(&pos, &tris, progress)?;
         let mut refined = refine::refine_near_curves(
             &mut pos,
             &mut tris,
