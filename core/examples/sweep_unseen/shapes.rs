@@ -1,0 +1,136 @@
+//! Templates of another shape, size or density than the curves' source: a coarse template with
+//! dense curves, a dense one with sparse curves, an icosphere aligned automatically onto spot or
+//! fandisk, thin flattened ellipsoids, and spot far from the origin or at extreme scales.
+
+use meshwork_core::fit::testdata::{bend, ellipsoid_sections, plane_sections, section_regions, to_unit_box};
+use meshwork_core::shapes::icosphere;
+
+use crate::support::{
+    case, flat_ellipsoid, flatten, read_as, repaired, sections_of, shared, sphere_sections, Case, Expect,
+    AXES,
+};
+
+pub fn shapes() -> Vec<Case> {
+    use serde_json::json;
+    let spot_regions = sections_of("spot").2;
+    let mut out = Vec::new();
+    out.push(case(
+        "coarse 80 faces, 5040 curve vertices",
+        || Ok(vec![icosphere(1, 1.0), sphere_sections(420)]),
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "coarse 320 faces, 2400 curve vertices",
+        || Ok(vec![icosphere(2, 1.0), sphere_sections(200)]),
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out.push(case(
+        "icosphere vs sections of spot (auto)",
+        || {
+            let (c, _, _) = sections_of("spot");
+            let mut t = icosphere(3, 0.5);
+            for p in &mut t.positions {
+                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
+            }
+            Ok(vec![t, c])
+        },
+        json!({}),
+        Expect::Fit(None),
+    ));
+    // Thin shapes: the two sheets of a flattened ellipsoid are closer than the template's edges
+    // are long, and the sections run over its rim from one sheet to the other.
+    // The curves are bent (`testdata::bend`, a smooth map the template does not know).
+    for (thick, level, round, bent) in [
+        (0.04, 4, false, false),
+        (0.04, 4, false, true),
+        (0.04, 3, false, true),
+        (0.1, 3, false, true),
+        (0.04, 3, true, true),
+    ] {
+        // The round template blows up (1,280 → 255k faces, minutes): run it on request only.
+        if round && std::env::var("SWEEP_SLOW").is_err() {
+            continue;
+        }
+        let (surface, planes) = flat_ellipsoid(thick);
+        let regions = section_regions(&surface, &planes);
+        let what = if round { "round icosphere" } else { "flat icosphere" };
+        let how = if bent { ", bent" } else { "" };
+        out.push(case(
+            &format!("{what} {level} vs sections of ellipsoid 1×0.6×{thick}{how} (auto)"),
+            move || {
+                let (surface, planes) = flat_ellipsoid(thick);
+                let mut t = icosphere(level, 0.5);
+                if !round {
+                    flatten(&mut t, thick);
+                }
+                let mut c = plane_sections(&surface, &planes);
+                if bent {
+                    for p in &mut c.positions {
+                        *p = bend(*p, 1.0);
+                    }
+                }
+                Ok(vec![t, c])
+            },
+            json!({}),
+            Expect::Fit(Some(regions)),
+        ));
+    }
+    out.push(case(
+        "spot in mm far from origin vs own sections",
+        || {
+            let (c, _, _) = sections_of("spot");
+            let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
+            to_unit_box(&mut t);
+            let mut c = c;
+            for m in [&mut t, &mut c] {
+                for p in &mut m.positions {
+                    *p = [p[0] * 1e3 + 2.5e4, p[1] * 1e3 - 4e4, p[2] * 1e3 + 7e3];
+                }
+            }
+            Ok(vec![t, c])
+        },
+        json!({}),
+        Expect::Fit(Some(spot_regions)),
+    ));
+    for (label, s, o) in [("spot scaled 1e-4", 1e-4, 0.0), ("spot size 1 at offset 1e6", 1.0, 1e6)] {
+        out.push(case(
+            label,
+            move || {
+                let (c, _, _) = sections_of("spot");
+                let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
+                to_unit_box(&mut t);
+                let mut c = c;
+                for m in [&mut t, &mut c] {
+                    for p in &mut m.positions {
+                        *p = [p[0] * s + o, p[1] * s - o, p[2] * s + o];
+                    }
+                }
+                Ok(vec![t, c])
+            },
+            json!({}),
+            Expect::Fit(None),
+        ));
+    }
+    out.push(case(
+        "icosphere vs sections of fandisk (auto)",
+        || {
+            let (c, _, _) = sections_of("fandisk");
+            let mut t = icosphere(3, 0.5);
+            for p in &mut t.positions {
+                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
+            }
+            Ok(vec![t, c])
+        },
+        json!({}),
+        Expect::Fit(None),
+    ));
+    out.push(case(
+        "dense template (20k faces), 4-point octants",
+        || Ok(vec![icosphere(5, 1.0), ellipsoid_sections(AXES, 1)]),
+        json!({}),
+        Expect::Fit(Some(8)),
+    ));
+    out
+}
