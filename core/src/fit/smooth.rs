@@ -247,8 +247,9 @@ fn orientation(pos: &[Point3], t: [u32; 3], reference: &[Point3]) -> f64 {
 
 /// Puts back to `before` (the positions before smoothing) every moved corner of a face that the
 /// smoothing turned against the `reference` vertex normals (or made degenerate) while it was
-/// right before, and repeats on the faces that changes, until no face is worse than before.
-/// Returns how many vertices were put back.
+/// right before, and repeats on the faces that changes, until no face is worse than before (a face
+/// thinner than the thinnest before smoothing counts as worse: a corner put back next to
+/// neighbours that stay smoothed must not make one). Returns how many vertices were put back.
 ///
 /// Why: the flows' guard ([`commit_safely`]) compares each step with the face's normal before
 /// that step, so a face can turn by small steps over many iterations until it faces away from
@@ -261,6 +262,11 @@ pub fn undo_new_flips(
     tris: &[[u32; 3]],
     reference: &[Point3],
 ) -> usize {
+    // A corner put back next to neighbours that stay smoothed could make a face thinner than any
+    // before smoothing: such a face counts as worse too, so the smallest angle never drops.
+    let quality =
+        |p: &[Point3], t: [u32; 3]| min_angle_quality(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
+    let floor = tris.iter().map(|&t| quality(before, t)).fold(f64::INFINITY, f64::min);
     let mut undone = 0;
     loop {
         let mut changed = 0;
@@ -269,7 +275,11 @@ pub fn undo_new_flips(
                 continue;
             }
             let (now, was) = (orientation(pos, t, reference), orientation(before, t, reference));
-            let worse = (now < 0.0 && was >= 0.0) || (now == 0.0 && was > 0.0);
+            let turned = (now < 0.0 && was >= 0.0) || (now == 0.0 && was > 0.0);
+            let worse = turned || {
+                let q = quality(pos, t);
+                q < floor && q < quality(before, t)
+            };
             if !worse {
                 continue;
             }
