@@ -488,8 +488,8 @@ mod tests {
     fn a_face_the_smoothing_turned_over_gets_its_moved_corners_back() {
         // Square A(-1,-1) B(1,-1) C(1,1) D(-1,1) around E(0,0), and F(3,0) beyond B–C, all in
         // z = 0 with reference normals +z. Smoothed: E went to (1.5, 0), past the edge B–C, so
-        // (B, C, E) turned over (hand: cross((0,2),(0.5,1)) = −1); F went to (3.5, 0), and its
-        // face (B, F, C) stays right. Only E goes back.
+        // (B, C, E) turned over (hand: cross((0,2),(0.5,1)) = −1); F went to (2.8, 0), and its
+        // face (B, F, C) stays right and fatter (smallest angle 53° → 58°). Only E goes back.
         let before = vec![
             [-1.0, -1.0, 0.0],
             [1.0, -1.0, 0.0],
@@ -502,18 +502,26 @@ mod tests {
         let reference = vec![[0.0, 0.0, 1.0]; 6];
         let mut pos = before.clone();
         pos[4] = [1.5, 0.0, 0.0];
-        pos[5] = [3.5, 0.0, 0.0];
+        pos[5] = [2.8, 0.0, 0.0];
         assert!(orientation(&pos, tris[1], &reference) < 0.0);
         assert_eq!(undo_new_flips(&mut pos, &before, &tris, &reference), 1);
         assert_eq!(pos[4], before[4]);
-        assert_eq!(pos[5], [3.5, 0.0, 0.0]);
-        // A face already turned over before smoothing is not the smoothing's doing: left alone.
+        assert_eq!(pos[5], [2.8, 0.0, 0.0]);
+        // A face already turned over before smoothing is not the smoothing's doing: left alone
+        // (E from (1.5, 0) to (1.45, 0): no face thinner than the thinnest before, 21.8°).
         let mut before2 = before.clone();
         before2[4] = [1.5, 0.0, 0.0];
         let mut pos2 = before2.clone();
-        pos2[4] = [1.6, 0.0, 0.0];
+        pos2[4] = [1.45, 0.0, 0.0];
         assert_eq!(undo_new_flips(&mut pos2, &before2, &tris, &reference), 0);
-        assert_eq!(pos2[4], [1.6, 0.0, 0.0]);
+        assert_eq!(pos2[4], [1.45, 0.0, 0.0]);
+        // F pushed out to (3.5, 0) instead makes (B, F, C) thinner (43.6° at F) than the thinnest
+        // face before (45°): it goes back too.
+        let mut pos3 = before.clone();
+        pos3[4] = [1.5, 0.0, 0.0];
+        pos3[5] = [3.5, 0.0, 0.0];
+        assert_eq!(undo_new_flips(&mut pos3, &before, &tris, &reference), 2);
+        assert_eq!(pos3, before);
     }
 
     #[test]
