@@ -19,15 +19,17 @@
 //! parameters into every fitting case; `SWEEP_SLOW=1` adds the round icosphere fitted to a
 //! flattened ellipsoid's sections, which takes minutes.)
 //!
-//! The cases live in one file per family (`templates`, `shapes`, `readers`, `networks`, `pairs`);
+//! The cases live in one file per family (`templates`, `shapes`, `readers`, `networks`, `pairs`, `layouts`, `spacings`);
 //! `support` has the `Case` type and the shared inputs, `check` the invariants. A new case goes
 //! into the family of what it varies (a new file for a new family, listed in `cases()`).
 
 mod check;
+mod layouts;
 mod networks;
 mod pairs;
 mod readers;
 mod shapes;
+mod spacings;
 mod support;
 mod templates;
 
@@ -42,10 +44,18 @@ use support::{Case, Expect};
 
 /// Every case, family by family.
 fn cases() -> Vec<Case> {
-    [templates::templates(), shapes::shapes(), readers::readers(), networks::networks(), pairs::pairs()]
-        .into_iter()
-        .flatten()
-        .collect()
+    [
+        templates::templates(),
+        shapes::shapes(),
+        readers::readers(),
+        networks::networks(),
+        pairs::pairs(),
+        layouts::layouts(),
+        spacings::spacings(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 fn main() {

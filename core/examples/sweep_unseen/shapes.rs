@@ -3,7 +3,9 @@
 //! fandisk, thin flattened ellipsoids, and spot far from the origin or at extreme scales.
 
 use meshwork_core::fit::testdata::{bend, ellipsoid_sections, plane_sections, section_regions, to_unit_box};
+use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
+use meshwork_core::Error;
 
 use crate::support::{
     case, flat_ellipsoid, flatten, read_as, repaired, sections_of, shared, sphere_sections, Case, Expect,
@@ -28,14 +30,7 @@ pub fn shapes() -> Vec<Case> {
     ));
     out.push(case(
         "icosphere vs sections of spot (auto)",
-        || {
-            let (c, _, _) = sections_of("spot");
-            let mut t = icosphere(3, 0.5);
-            for p in &mut t.positions {
-                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
-            }
-            Ok(vec![t, c])
-        },
+        || icosphere_vs_sections_of("spot"),
         json!({}),
         Expect::Fit(None),
     ));
@@ -79,50 +74,16 @@ pub fn shapes() -> Vec<Case> {
     }
     out.push(case(
         "spot in mm far from origin vs own sections",
-        || {
-            let (c, _, _) = sections_of("spot");
-            let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-            to_unit_box(&mut t);
-            let mut c = c;
-            for m in [&mut t, &mut c] {
-                for p in &mut m.positions {
-                    *p = [p[0] * 1e3 + 2.5e4, p[1] * 1e3 - 4e4, p[2] * 1e3 + 7e3];
-                }
-            }
-            Ok(vec![t, c])
-        },
+        || spot_and_sections_moved(1e3, [2.5e4, -4e4, 7e3]),
         json!({}),
         Expect::Fit(Some(spot_regions)),
     ));
     for (label, s, o) in [("spot scaled 1e-4", 1e-4, 0.0), ("spot size 1 at offset 1e6", 1.0, 1e6)] {
-        out.push(case(
-            label,
-            move || {
-                let (c, _, _) = sections_of("spot");
-                let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-                to_unit_box(&mut t);
-                let mut c = c;
-                for m in [&mut t, &mut c] {
-                    for p in &mut m.positions {
-                        *p = [p[0] * s + o, p[1] * s - o, p[2] * s + o];
-                    }
-                }
-                Ok(vec![t, c])
-            },
-            json!({}),
-            Expect::Fit(None),
-        ));
+        out.push(case(label, move || spot_and_sections_moved(s, [o, -o, o]), json!({}), Expect::Fit(None)));
     }
     out.push(case(
         "icosphere vs sections of fandisk (auto)",
-        || {
-            let (c, _, _) = sections_of("fandisk");
-            let mut t = icosphere(3, 0.5);
-            for p in &mut t.positions {
-                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
-            }
-            Ok(vec![t, c])
-        },
+        || icosphere_vs_sections_of("fandisk"),
         json!({}),
         Expect::Fit(None),
     ));
@@ -133,4 +94,28 @@ pub fn shapes() -> Vec<Case> {
         Expect::Fit(Some(8)),
     ));
     out
+}
+
+/// An icosphere of radius 0.5 in the unit box (the sweep's frame) and the sections of shared
+/// mesh `name`: a template of another shape, aligned automatically.
+fn icosphere_vs_sections_of(name: &str) -> Result<Vec<Mesh>, Error> {
+    let (c, _, _) = sections_of(name);
+    let mut t = icosphere(3, 0.5);
+    for p in &mut t.positions {
+        *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
+    }
+    Ok(vec![t, c])
+}
+
+/// Spot (repaired, unit box) and its own sections, both scaled by `s` and moved by `o`.
+fn spot_and_sections_moved(s: f64, o: Point3) -> Result<Vec<Mesh>, Error> {
+    let (mut c, _, _) = sections_of("spot");
+    let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
+    to_unit_box(&mut t);
+    for m in [&mut t, &mut c] {
+        for p in &mut m.positions {
+            *p = [p[0] * s + o[0], p[1] * s + o[1], p[2] * s + o[2]];
+        }
+    }
+    Ok(vec![t, c])
 }

@@ -121,7 +121,7 @@ pub fn approach(
                 Some(feet) => feet,
                 None => feet_of(pos, &all)?,
             };
-            let (feet, walked) = walked_feet(pos, tris, &vf, net, &anchor, closest);
+            let (feet, walked) = walked_feet(pos, tris, &vf, net, &anchor, closest, progress)?;
             report.walked_feet.push(walked);
             sample.iter().map(|&p| feet[p as usize]).collect()
         } else {
@@ -190,13 +190,15 @@ fn walked_feet(
     net: &CurveNetwork,
     anchor: &[bool],
     closest: Vec<(u32, Point3, f64)>,
-) -> (Vec<(u32, Point3, f64)>, usize) {
+    progress: &Progress,
+) -> Result<(Vec<(u32, Point3, f64)>, usize)> {
+    use super::insert::walk::walk_feet_directed;
     let mut forward = closest.clone();
-    if super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut forward, anchor, false) == 0 {
-        return (forward, 0);
+    if walk_feet_directed(pos, tris, vf, net, &mut forward, anchor, false, progress)? == 0 {
+        return Ok((forward, 0));
     }
     let mut backward = closest.clone();
-    super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut backward, anchor, true);
+    walk_feet_directed(pos, tris, vf, net, &mut backward, anchor, true, progress)?;
     let mut walked = 0;
     let mut feet = closest;
     for ((c, f), b) in feet.iter_mut().zip(&forward).zip(&backward) {
@@ -206,7 +208,7 @@ fn walked_feet(
             walked += 1;
         }
     }
-    (feet, walked)
+    Ok((feet, walked))
 }
 
 /// Faces whose normal turns by more than 90° between `before` and `after`.
@@ -328,7 +330,7 @@ mod tests {
             (c[4].1[2] - 0.1).abs() < 1e-12 && (c[5].1[2] - 0.1).abs() < 1e-12,
             "the case: closest points on the upper sheet"
         );
-        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c);
+        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c, &Progress::new()).unwrap();
         assert_eq!(walked, 2);
         for (p, f) in feet.iter().enumerate() {
             assert!(f.1[2].abs() < 1e-12, "point {p} on the upper sheet");
@@ -357,12 +359,15 @@ mod tests {
             &mut forward,
             &anchor,
             false,
-        );
+            &Progress::new(),
+        )
+        .unwrap();
         assert!(
             changed > 0 && (forward[4].1[2] - 0.1).abs() < 1e-12,
             "the case: the one-sided walk goes astray"
         );
-        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone());
+        let (feet, walked) =
+            walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone(), &Progress::new()).unwrap();
         assert_eq!(walked, 0);
         assert_eq!(feet.iter().map(|f| f.1).collect::<Vec<_>>(), c.iter().map(|f| f.1).collect::<Vec<_>>());
     }

@@ -111,11 +111,20 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         trimesh::check_oriented_manifold_faces(&tris, Some(&face_of))?;
         Ok(tris)
     })?;
-    let template_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
+    let given_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
 
     let coarse =
         stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
+    // Distances from here on (max_curve_distance, end snaps, the relative residual) are measured
+    // on the aligned template: an alignment that scales (a template in metres, curves in
+    // centimetres) must scale the limits with it, or curves 100× larger are refused as "far"
+    // against the template's size before alignment. Except when part of the network is far from
+    // the rest (a stray curve): the alignment then stretches the template towards it, and the
+    // smaller size keeps the stray curve an error that names it.
+    let aligned_diag = Aabb::of(&pos).map(|b| b.diagonal()).unwrap_or(0.0);
+    let template_diag =
+        if net.stray_parts().is_empty() { aligned_diag } else { aligned_diag.min(given_diag) };
 
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
@@ -135,7 +144,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
         // One closest-point search (a BVH over the approached template) for the refinement's
         // density check and the insertion's feet; the refinement replaces it when it splits.
-        let mut search = insert::FootSearch::new(&pos, &tris)?;
+        let mut search = insert::FootSearch::new_polled(&pos, &tris, progress)?;
         let mut refined = refine::refine_near_curves(
             &mut pos,
             &mut tris,
