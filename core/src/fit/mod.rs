@@ -345,7 +345,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
         smoothing = stages.run(progress, "smooth", || {
-            smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
+            let mut s = smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)?;
+            s.undone_for_flips =
+                smooth::undo_new_flips(&mut out_pos, &mesh.pos, &out_tris, &reference_normals);
+            Ok(s)
         })?;
     }
     // Smoothed vertices slid over the surface: their UVs are read where they now are.
