@@ -4,7 +4,8 @@
 //! `progress.check()` (the service's time limit and cancel rely on it).
 //!
 //! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example cancel_latency [SAMPLES] [FILTER]`
-//! (meshes from `../shared/meshes/`; FILTER keeps the jobs whose name contains it). The inputs
+//! (meshes from `../shared/meshes/`; FILTER keeps the jobs whose name contains it;
+//! `CANCEL_EACH=1` prints every cancel's stage and overshoots on stderr). The inputs
 //! are ~100k-vertex meshes: the bunny split once (139k vertices), homer split twice (96k).
 //!
 //! Two overshoots per cancel: wall time, and the CPU time all threads of this process spent from
@@ -104,6 +105,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let samples: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(12);
     let filter = args.get(2).cloned().unwrap_or_default();
+    // CANCEL_EACH=1: every cancel on stderr (where each stage's overshoots are).
+    let each = std::env::var("CANCEL_EACH").is_ok();
     let bunny = subdivide_midpoint(&load("stanford-bunny.obj"), 1);
     let homer = load("homer.obj");
     let homer96 = subdivide_midpoint(&homer, 2);
@@ -157,6 +160,16 @@ fn main() {
         for i in 1..=samples {
             let d = full.mul_f64(i as f64 / (samples + 1) as f64);
             let r = timed(*kind, inputs, params, Some(d));
+            if each {
+                eprintln!(
+                    "  {name}: cancel at {:.0} ms: {} in {}, wall {:.1} ms, CPU {:.1} ms",
+                    d.as_secs_f64() * 1e3,
+                    r.result,
+                    r.stage,
+                    r.wall.as_secs_f64() * 1e3,
+                    r.cpu.as_secs_f64() * 1e3
+                );
+            }
             kinds.insert(r.result);
             if r.wall > wall.0 {
                 wall = (r.wall, r.stage.clone());

@@ -56,6 +56,25 @@ pub fn icosphere(levels: u32, radius: f64) -> Mesh {
     Mesh::from_triangles(pos, &tris)
 }
 
+/// The unit icosphere of `levels` with the faces around its north pole removed: those whose
+/// centroid is above z = cos(`deg`) (a hole of one boundary loop for repair's hole filling).
+/// Returns the mesh (all vertices kept) and the removed area.
+pub fn icosphere_without_cap(levels: u32, deg: f64) -> (Mesh, f64) {
+    let m = icosphere(levels, 1.0);
+    let cos = deg.to_radians().cos();
+    let mut removed = 0.0;
+    let mut faces = Faces::new();
+    for f in m.faces.iter() {
+        let p: Vec<Point3> = f.iter().map(|&v| m.positions[v as usize]).collect();
+        if (p[0][2] + p[1][2] + p[2][2]) / 3.0 > cos {
+            removed += crate::geometry::triangle_area(p[0], p[1], p[2]);
+        } else {
+            faces.push(f, 0);
+        }
+    }
+    (Mesh::new(m.positions, faces), removed)
+}
+
 /// One 1→4 midpoint subdivision of every triangle; `place` maps each new midpoint (e.g. onto a
 /// sphere). Shared edges get one midpoint, so a closed mesh stays closed.
 fn split_triangles(

@@ -71,3 +71,53 @@ fn a_flat_template_fits_bent_sections_of_a_thin_ellipsoid() {
     assert_eq!(r["flipped_faces"].as_u64(), Some(0));
     assert_eq!(r["segments_as_edges"].as_f64(), Some(1.0));
 }
+
+/// Three great circles of 48 points on the unit sphere (sharing the 6 axis points: 3·48 − 6 = 138
+/// curve vertices) and a level-3 icosphere (1,280 triangles): the face guard's base is
+/// 1,280 + 8 · 138 = 2,384 faces.
+fn octants() -> Vec<Mesh> {
+    use meshwork_core::fit::testdata::{great_circles, polylines};
+    vec![icosphere(3, 1.0), polylines(&great_circles(1.0, 48, [0.0; 3]))]
+}
+
+#[test]
+fn a_fit_past_its_face_budget_stops_naming_the_stage() {
+    // Half the base (1,192) is below the template's own 1,280 triangles: the guard trips as soon
+    // as the fine stage's mesh is built.
+    let params = FitParams { max_face_growth: 0.5, ..Default::default() };
+    let err = match run(octants(), &params, &Progress::new()) {
+        Err(e) => e,
+        Ok(_) => panic!("a fit with 1,192 faces allowed went through"),
+    };
+    let text = err.to_string();
+    match err {
+        meshwork_core::Error::TooLarge { limit, actual, .. } => {
+            assert_eq!(limit, 1192, "{text}");
+            // The template's triangles plus the insertion's splits (each adds faces).
+            assert!(actual > 1280, "{text}");
+        }
+        other => panic!("expected too-large, got {other:?}"),
+    }
+    assert!(text.contains("stage `fine`") && text.contains("max_face_growth"), "{text}");
+}
+
+#[test]
+fn the_default_face_budget_leaves_an_ordinary_fit_alone() {
+    let out = run(octants(), &FitParams::default(), &Progress::new()).expect("fit");
+    let r = &out.report;
+    assert_eq!(r["regions"].as_u64(), Some(8));
+    assert_eq!(r["face_growth"]["base"].as_u64(), Some(2384));
+    let peak = r["face_growth"]["peak_faces"].as_u64().unwrap();
+    // At least the template's faces, and the output never has more than the peak.
+    assert!(peak >= 1280 && r["output_faces"].as_u64().unwrap() <= peak, "peak {peak}");
+    assert!(peak < 2384, "an 8-octant fit used {peak} faces");
+}
+
+#[test]
+fn max_face_growth_must_be_positive() {
+    for bad in [0.0, -1.0, f64::NAN] {
+        let params = FitParams { max_face_growth: bad, ..Default::default() };
+        let err = run(octants(), &params, &Progress::new()).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(err.contains("max_face_growth"), "{bad}: {err}");
+    }
+}

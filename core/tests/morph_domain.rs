@@ -15,7 +15,7 @@ use meshwork_core::shapes;
 use serde_json::json;
 
 mod morph_support;
-use morph_support::{bbox_diag, dist_brute, load, relative_distance_brute};
+use morph_support::{bbox_diag, disk, dist_brute, load, relative_distance_brute};
 
 const RINGS: usize = 10;
 const SEG: usize = 24;
@@ -79,14 +79,9 @@ fn finned_hemisphere() -> Mesh {
 
 /// z = 0.5·(x² + y²) over the unit disk (a clean disk target of another connectivity).
 fn paraboloid(n: usize) -> Mesh {
-    let mut m = shapes::grid(n, n, 2.0 / n as f64, false);
+    let mut m = disk(n);
     for p in &mut m.positions {
-        let (x, y) = (p[0] - 1.0, p[1] - 1.0);
-        let r = x.abs().max(y.abs());
-        let l = x.hypot(y);
-        let f = if l > 0.0 { r / l } else { 0.0 };
-        let (u, v) = (x * f, y * f);
-        *p = [u, v, 0.5 * (u * u + v * v)];
+        p[2] = 0.5 * (p[0] * p[0] + p[1] * p[1]);
     }
     m
 }

@@ -5,7 +5,7 @@
 
 use std::f64::consts::PI;
 
-use meshwork_core::geometry::{cross, dot, norm, sub};
+use meshwork_core::geometry::{cross, norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings, SphereMethod};
@@ -15,7 +15,7 @@ use meshwork_core::register;
 use meshwork_core::shapes;
 
 mod morph_support;
-use morph_support::{bbox_diag, load, max_dist_brute, spherical_area};
+use morph_support::{bbox_diag, ellipsoid, extreme_vertex, load, max_dist_brute, spherical_area};
 
 /// Every spherical triangle positive and the areas adding up to 4π: a bijection onto the sphere.
 fn assert_covers_sphere_once(name: &str, sphere: &[Point3], tris: &[[u32; 3]]) {
@@ -35,14 +35,6 @@ fn trimesh(m: &Mesh) -> TriMesh {
     let (t, _, _) = TriMesh::from_mesh(m);
     let f = register::pca_frame(&t.pos, &t.tris).to_normalised;
     TriMesh { pos: t.pos.iter().map(|&p| f.apply(p)).collect(), tris: t.tris }
-}
-
-fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
-    let mut m = shapes::icosphere(levels, 1.0);
-    for p in &mut m.positions {
-        *p = [p[0] * axes[0], p[1] * axes[1], p[2] * axes[2]];
-    }
-    m
 }
 
 /// A dumbbell: two bulbs joined by a waist 8× thinner, 12 units long (icosphere level 4,
@@ -246,15 +238,10 @@ fn repaired_cow_takes_the_better_tutte_map_inside_the_seed_range() {
 fn feature_pairs_meet_on_the_fallback_map() {
     let a = shapes::icosphere(3, 1.0);
     let b = ellipsoid(3, [1.5, 1.0, 0.7]);
-    let nearest = |m: &Mesh, d: Point3| -> u32 {
-        (0..m.positions.len())
-            .max_by(|&i, &j| dot(m.positions[i], d).total_cmp(&dot(m.positions[j], d)))
-            .expect("non-empty") as u32
-    };
     // Mismatched on purpose: a's +y pole onto b's +x tip, a's +z onto b's −y.
     let pairs = [
-        (nearest(&a, [0.0, 1.0, 0.0]), nearest(&b, [1.0, 0.0, 0.0])),
-        (nearest(&a, [0.0, 0.0, 1.0]), nearest(&b, [0.0, -1.0, 0.0])),
+        (extreme_vertex(&a, [0.0, 1.0, 0.0]), extreme_vertex(&b, [1.0, 0.0, 0.0])),
+        (extreme_vertex(&a, [0.0, 0.0, 1.0]), extreme_vertex(&b, [0.0, -1.0, 0.0])),
     ];
     let out = job::run(
         JobKind::Morph,

@@ -3,7 +3,7 @@
 //! points for the end frames, an analytic ellipsoid, the Khronos validator for the GLB.
 
 use meshwork_core::error::Error;
-use meshwork_core::geometry::{dot, norm, sub};
+use meshwork_core::geometry::{norm, sub};
 use meshwork_core::job::{self, JobKind, Progress};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::morph::param::{self, ParamSettings};
@@ -12,15 +12,9 @@ use meshwork_core::register;
 use meshwork_core::shapes;
 
 mod morph_support;
-use morph_support::{bbox_diag, khronos_report, load, max_dist_brute, spherical_area};
-
-fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
-    let mut m = shapes::icosphere(levels, 1.0);
-    for p in &mut m.positions {
-        *p = [p[0] * axes[0], p[1] * axes[1], p[2] * axes[2]];
-    }
-    m
-}
+use morph_support::{
+    bbox_diag, ellipsoid, extreme_vertex, khronos_report, load, max_dist_brute, spherical_area,
+};
 
 fn settings() -> ParamSettings {
     ParamSettings {
@@ -198,14 +192,9 @@ fn feature_pairs_meet() {
     let a = shapes::icosphere(3, 1.0);
     let b = ellipsoid(3, [1.5, 1.0, 0.7]);
     // Deliberately mismatched pairs: a's +y pole with b's +x tip, a's +z with b's −y.
-    let nearest = |m: &Mesh, d: Point3| -> u32 {
-        (0..m.positions.len())
-            .max_by(|&i, &j| dot(m.positions[i], d).total_cmp(&dot(m.positions[j], d)))
-            .unwrap() as u32
-    };
     let pairs = [
-        (nearest(&a, [0.0, 1.0, 0.0]), nearest(&b, [1.0, 0.0, 0.0])),
-        (nearest(&a, [0.0, 0.0, 1.0]), nearest(&b, [0.0, -1.0, 0.0])),
+        (extreme_vertex(&a, [0.0, 1.0, 0.0]), extreme_vertex(&b, [1.0, 0.0, 0.0])),
+        (extreme_vertex(&a, [0.0, 0.0, 1.0]), extreme_vertex(&b, [0.0, -1.0, 0.0])),
     ];
     let out = job::run(
         JobKind::Morph,

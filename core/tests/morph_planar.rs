@@ -12,7 +12,7 @@ use meshwork_core::morph::trimesh::TriMesh;
 use meshwork_core::shapes;
 
 mod morph_support;
-use morph_support::{bbox_diag, khronos_report, load, max_dist_brute};
+use morph_support::{bbox_diag, disk, khronos_report, load, max_dist_brute};
 
 fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     shapes::fan_triangles(&m.faces)
@@ -25,19 +25,6 @@ fn hausdorff(a: &Mesh, b: &Mesh) -> f64 {
     let (ta, tb) = (tris_of(a), tris_of(b));
     max_dist_brute(&a.positions, &b.positions, &tb).max(max_dist_brute(&b.positions, &a.positions, &ta))
         / bbox_diag(&b.positions)
-}
-
-/// An n×n grid on [−1, 1]² pushed radially onto the unit disk (square rings → circles), z = 0.
-fn disk(n: usize) -> Mesh {
-    let mut m = shapes::grid(n, n, 2.0 / n as f64, false);
-    for p in &mut m.positions {
-        let (x, y) = (p[0] - 1.0, p[1] - 1.0);
-        let r = x.abs().max(y.abs());
-        let l = x.hypot(y);
-        let f = if l > 0.0 { r / l } else { 0.0 };
-        *p = [x * f, y * f, 0.0];
-    }
-    m
 }
 
 /// z = 0.6·(x² + y²) over the disk (a different grid resolution).

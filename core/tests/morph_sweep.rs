@@ -11,6 +11,9 @@ use meshwork_core::shapes::{cube, icosphere, octahedron as octa, tetrahedron as 
 use meshwork_core::spatial::closest_on_triangle;
 use serde_json::json;
 
+mod morph_support;
+use morph_support::ellipsoid;
+
 fn tris_of(m: &Mesh) -> Vec<[u32; 3]> {
     m.faces.iter().map(|f| [f[0], f[1], f[2]]).collect()
 }
@@ -109,14 +112,6 @@ fn coarse_polyhedra_morph_reproduces_both_ends() {
         ));
         assert!(d / diag(&b.positions) < 1e-9, "last frame off the target by {d}");
     }
-}
-
-fn ellipsoid(levels: u32, ax: Point3) -> Mesh {
-    let mut m = icosphere(levels, 1.0);
-    for p in &mut m.positions {
-        *p = [p[0] * ax[0], p[1] * ax[1], p[2] * ax[2]];
-    }
-    m
 }
 
 /// Feature pairs meet exactly on the sphere, so A- and B-vertices coincide there: the overlay

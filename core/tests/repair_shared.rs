@@ -147,22 +147,7 @@ fn beetle_tangle_does_not_panic_and_ends_without_non_manifold_edges() {
 
 // ---- analytic shapes -------------------------------------------------------------------
 
-/// Icosphere with faces whose centroid is above z = cos(deg) removed; returns the removed area.
-fn capped(level: u32, deg: f64) -> (Mesh, f64) {
-    let m = shapes::icosphere(level, 1.0);
-    let cos = deg.to_radians().cos();
-    let mut removed = 0.0;
-    let mut faces = Faces::new();
-    for f in m.faces.iter() {
-        let p: Vec<[f64; 3]> = f.iter().map(|&v| m.positions[v as usize]).collect();
-        if (p[0][2] + p[1][2] + p[2][2]) / 3.0 > cos {
-            removed += meshwork_core::geometry::triangle_area(p[0], p[1], p[2]);
-        } else {
-            faces.push(f, 0);
-        }
-    }
-    (Mesh::new(m.positions, faces), removed)
-}
+use shapes::icosphere_without_cap as capped;
 
 #[test]
 fn icosphere_cap_filled_and_closed() {

@@ -58,6 +58,8 @@ pub fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
     } else {
         0.0
     };
+    // Points welded into another within join_tolerance moved by at most the reported distance.
+    let overlap_gap = overlap_gap.max(r["network"]["welded_max_distance"].as_f64().unwrap_or(0.0));
     if worst > (1e-9 * cdiag).max(overlap_gap * (1.0 + 1e-9))
         && r["network"]["near_duplicates_merged"] == 0
         && r["network"]["ends_merged"] == 0

@@ -53,5 +53,52 @@ pub fn pairs() -> Vec<Case> {
         json!({"pairs": [p(0, [1.4, 0.0, 0.0]), {"template_vertex": -1, "curve_point": [0, 0, 0]}]}),
         Expect::Error(&["template_vertex"]),
     ));
+
+    out.push(case(
+        "pair template vertex beyond the mesh",
+        || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
+        json!({"pairs": [p(0, [1.4, 0.0, 0.0]), p(5, [0.0, 1.15, 0.0]), p(9, [0.0, 0.0, 0.9]), p(642, [-1.4, 0.0, 0.0])]}),
+        Expect::Error(&["pairs[3]", "642"]),
+    ));
+
+    out.push(case(
+        "pair template vertex u32 max",
+        || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
+        json!({"pairs": [p(0, [1.4, 0.0, 0.0]), p(5, [0.0, 1.15, 0.0]), p(9, [0.0, 0.0, 0.9]), {"template_vertex": 4294967295u64, "curve_point": [-1.4, 0.0, 0.0]}]}),
+        Expect::Error(&["pairs[3]"]),
+    ));
+
+    out.push(case(
+        "pair template vertex 2^40",
+        || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
+        json!({"pairs": [{"template_vertex": 1099511627776u64, "curve_point": [-1.4, 0.0, 0.0]}]}),
+        Expect::Error(&["pairs"]),
+    ));
+
+    out.push(case(
+        "pair curve point 1e300",
+        || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
+        json!({"pairs": [p(0, [1.4, 0.0, 0.0]), p(5, [0.0, 1.15, 0.0]), p(9, [0.0, 0.0, 0.9]), p(11, [1e300, 0.0, 0.0])]}),
+        Expect::Error(&["pairs[3]"]),
+    ));
+
+    out.push(case(
+        "3 pairs only (too few centres)",
+        || Ok(vec![icosphere(3, 1.0), sphere_sections(6)]),
+        json!({"pairs": [p(0, [1.4, 0.0, 0.0]), p(5, [0.0, 1.15, 0.0]), p(9, [0.0, 0.0, 0.9])]}),
+        Expect::Error(&["pairs"]),
+    ));
+    out.push(case(
+        "JSON polylines: a 1-point polyline and a null",
+        || {
+            let m = meshwork_core::fit::curves::polylines_from_json(
+                br#"{"polylines": [[[0,0,1]], [[0,1,0],[null,0,0]]]}"#,
+            )
+            .expect("json")?;
+            Ok(vec![icosphere(2, 1.0), m])
+        },
+        json!({}),
+        Expect::Error(&["polylines[0]"]),
+    ));
     out
 }

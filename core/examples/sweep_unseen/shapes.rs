@@ -3,7 +3,9 @@
 //! fandisk, thin flattened ellipsoids, and spot far from the origin or at extreme scales.
 
 use meshwork_core::fit::testdata::{bend, ellipsoid_sections, plane_sections, section_regions, to_unit_box};
+use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
+use meshwork_core::Error;
 
 use crate::support::{
     case, flat_ellipsoid, flatten, read_as, repaired, sections_of, shared, sphere_sections, Case, Expect,
@@ -28,14 +30,7 @@ pub fn shapes() -> Vec<Case> {
     ));
     out.push(case(
         "icosphere vs sections of spot (auto)",
-        || {
-            let (c, _, _) = sections_of("spot");
-            let mut t = icosphere(3, 0.5);
-            for p in &mut t.positions {
-                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
-            }
-            Ok(vec![t, c])
-        },
+        || icosphere_vs_sections_of("spot"),
         json!({}),
         Expect::Fit(None),
     ));
@@ -49,10 +44,6 @@ pub fn shapes() -> Vec<Case> {
         (0.1, 3, false, true),
         (0.04, 3, true, true),
     ] {
-        // The round template blows up (1,280 → 255k faces, minutes): run it on request only.
-        if round && std::env::var("SWEEP_SLOW").is_err() {
-            continue;
-        }
         let (surface, planes) = flat_ellipsoid(thick);
         let regions = section_regions(&surface, &planes);
         let what = if round { "round icosphere" } else { "flat icosphere" };
@@ -74,55 +65,28 @@ pub fn shapes() -> Vec<Case> {
                 Ok(vec![t, c])
             },
             json!({}),
-            Expect::Fit(Some(regions)),
+            // The round template cannot follow a thin target: without the face guard it ran for
+            // 200–470 s to 255k–361k faces, 8 of 20 regions and ~1,400 flipped faces; the guard
+            // (`max_face_growth`) stops it at the re-triangulation in seconds, naming the stage.
+            if round {
+                Expect::Error(&["max_face_growth", "exceeds the limit", "retriangulate"])
+            } else {
+                Expect::Fit(Some(regions))
+            },
         ));
     }
     out.push(case(
         "spot in mm far from origin vs own sections",
-        || {
-            let (c, _, _) = sections_of("spot");
-            let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-            to_unit_box(&mut t);
-            let mut c = c;
-            for m in [&mut t, &mut c] {
-                for p in &mut m.positions {
-                    *p = [p[0] * 1e3 + 2.5e4, p[1] * 1e3 - 4e4, p[2] * 1e3 + 7e3];
-                }
-            }
-            Ok(vec![t, c])
-        },
+        || spot_and_sections_moved(1e3, [2.5e4, -4e4, 7e3]),
         json!({}),
         Expect::Fit(Some(spot_regions)),
     ));
     for (label, s, o) in [("spot scaled 1e-4", 1e-4, 0.0), ("spot size 1 at offset 1e6", 1.0, 1e6)] {
-        out.push(case(
-            label,
-            move || {
-                let (c, _, _) = sections_of("spot");
-                let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-                to_unit_box(&mut t);
-                let mut c = c;
-                for m in [&mut t, &mut c] {
-                    for p in &mut m.positions {
-                        *p = [p[0] * s + o, p[1] * s - o, p[2] * s + o];
-                    }
-                }
-                Ok(vec![t, c])
-            },
-            json!({}),
-            Expect::Fit(None),
-        ));
+        out.push(case(label, move || spot_and_sections_moved(s, [o, -o, o]), json!({}), Expect::Fit(None)));
     }
     out.push(case(
         "icosphere vs sections of fandisk (auto)",
-        || {
-            let (c, _, _) = sections_of("fandisk");
-            let mut t = icosphere(3, 0.5);
-            for p in &mut t.positions {
-                *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
-            }
-            Ok(vec![t, c])
-        },
+        || icosphere_vs_sections_of("fandisk"),
         json!({}),
         Expect::Fit(None),
     ));
@@ -133,4 +97,28 @@ pub fn shapes() -> Vec<Case> {
         Expect::Fit(Some(8)),
     ));
     out
+}
+
+/// An icosphere of radius 0.5 in the unit box (the sweep's frame) and the sections of shared
+/// mesh `name`: a template of another shape, aligned automatically.
+fn icosphere_vs_sections_of(name: &str) -> Result<Vec<Mesh>, Error> {
+    let (c, _, _) = sections_of(name);
+    let mut t = icosphere(3, 0.5);
+    for p in &mut t.positions {
+        *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
+    }
+    Ok(vec![t, c])
+}
+
+/// Spot (repaired, unit box) and its own sections, both scaled by `s` and moved by `o`.
+fn spot_and_sections_moved(s: f64, o: Point3) -> Result<Vec<Mesh>, Error> {
+    let (mut c, _, _) = sections_of("spot");
+    let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
+    to_unit_box(&mut t);
+    for m in [&mut t, &mut c] {
+        for p in &mut m.positions {
+            *p = [p[0] * s + o[0], p[1] * s + o[1], p[2] * s + o[2]];
+        }
+    }
+    Ok(vec![t, c])
 }

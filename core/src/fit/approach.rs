@@ -43,6 +43,9 @@ pub struct ApproachReport {
     pub refined: Vec<super::field_refine::FieldRefineStats>,
     /// Extra runs of the densest level (after a refinement, while its samples stay far).
     pub repeats: usize,
+    /// Sampled curve points per level whose foot was moved from a sheet to the rim, because they
+    /// lie between the template's two sheets near its rim ([`super::thin`]).
+    pub rim_feet: Vec<usize>,
 }
 
 /// Field refinement gate ([`super::field_refine`]): a level's sample missed by more than this
@@ -76,7 +79,8 @@ fn level_sizes(n: usize, levels: usize) -> Vec<usize> {
 
 /// Moves `pos` towards the curves in up to `levels` levels. `fixed` template vertices (user pairs
 /// already on their curve points) are centres with zero displacement at every level. Nothing moves
-/// when a curve vertex is farther than `max_distance` from the surface.
+/// when a curve vertex is farther than `max_distance` from the surface. With `rim_feet`, feet of
+/// points between two sheets of a thin part are moved to its rim ([`super::thin`]).
 #[allow(clippy::too_many_arguments)]
 pub fn approach(
     pos: &mut Vec<Point3>,
@@ -87,6 +91,7 @@ pub fn approach(
     kernel: Kernel,
     levels: usize,
     max_distance: f64,
+    rim_feet: bool,
     progress: &Progress,
 ) -> Result<ApproachReport> {
     let mut report = ApproachReport::default();
@@ -149,12 +154,16 @@ pub fn approach(
                 Some(feet) => feet,
                 None => feet_of(pos, tris, &vf, &all)?,
             };
-            let (feet, walked) = walked_feet(pos, tris, &vf, net, &anchor, closest);
+            let (feet, walked) = walked_feet(pos, tris, &vf, net, &anchor, closest, progress)?;
             report.walked_feet.push(walked);
             sample.iter().map(|&p| feet[p as usize]).collect()
         } else {
             feet_of(pos, tris, &vf, &sample)?
         };
+        let mut feet = feet;
+        if rim_feet {
+            report.rim_feet.push(super::thin::rim_feet(pos, tris, &vf, &net.points, &sample, &mut feet));
+        }
         report.distance_max.push(feet.iter().map(|f| f.2).fold(0.0, f64::max));
         report.distance_mean.push(feet.iter().map(|f| f.2).sum::<f64>() / feet.len().max(1) as f64);
         let mut centres: Vec<Point3> = Vec::with_capacity(sample.len() + fixed.len());
@@ -250,13 +259,15 @@ fn walked_feet(
     net: &CurveNetwork,
     anchor: &[bool],
     closest: Vec<(u32, Point3, f64)>,
-) -> (Vec<(u32, Point3, f64)>, usize) {
+    progress: &Progress,
+) -> Result<(Vec<(u32, Point3, f64)>, usize)> {
+    use super::insert::walk::walk_feet_directed;
     let mut forward = closest.clone();
-    if super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut forward, anchor, false) == 0 {
-        return (forward, 0);
+    if walk_feet_directed(pos, tris, vf, net, &mut forward, anchor, false, progress)? == 0 {
+        return Ok((forward, 0));
     }
     let mut backward = closest.clone();
-    super::insert::walk::walk_feet_directed(pos, tris, vf, net, &mut backward, anchor, true);
+    walk_feet_directed(pos, tris, vf, net, &mut backward, anchor, true, progress)?;
     let mut walked = 0;
     let mut feet = closest;
     for ((c, f), b) in feet.iter_mut().zip(&forward).zip(&backward) {
@@ -266,7 +277,7 @@ fn walked_feet(
             walked += 1;
         }
     }
-    (feet, walked)
+    Ok((feet, walked))
 }
 
 /// Faces whose normal turns by more than 90° between `before` and `after`.
@@ -388,7 +399,7 @@ mod tests {
             (c[4].1[2] - 0.1).abs() < 1e-12 && (c[5].1[2] - 0.1).abs() < 1e-12,
             "the case: closest points on the upper sheet"
         );
-        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c);
+        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c, &Progress::new()).unwrap();
         assert_eq!(walked, 2);
         for (p, f) in feet.iter().enumerate() {
             assert!(f.1[2].abs() < 1e-12, "point {p} on the upper sheet");
@@ -417,12 +428,15 @@ mod tests {
             &mut forward,
             &anchor,
             false,
-        );
+            &Progress::new(),
+        )
+        .unwrap();
         assert!(
             changed > 0 && (forward[4].1[2] - 0.1).abs() < 1e-12,
             "the case: the one-sided walk goes astray"
         );
-        let (feet, walked) = walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone());
+        let (feet, walked) =
+            walked_feet(&pos, &tris, &vf, &net, &anchor, c.clone(), &Progress::new()).unwrap();
         assert_eq!(walked, 0);
         assert_eq!(feet.iter().map(|f| f.1).collect::<Vec<_>>(), c.iter().map(|f| f.1).collect::<Vec<_>>());
     }

@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::geometry::{add, sub, Aabb};
+use crate::geometry::{add, dist, sub, Aabb};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -313,22 +313,21 @@ fn snap_pairs(
         if !p.curve_point.iter().all(|c| c.is_finite()) {
             return Err(Error::params(format!("pairs[{i}].curve_point"), "coordinate is NaN or infinite"));
         }
-        let (cp, d2) =
-            tree.nearest(p.curve_point).ok_or_else(|| Error::Internal("empty curve network".into()))?;
-        snap_max = snap_max.max(d2.sqrt());
-        if d2.sqrt() > limit {
+        // A point so far away that its squared distance overflows (1e300) has no nearest vertex
+        // in the tree: it is as far as can be, the same error.
+        let nearest = tree.nearest(p.curve_point).filter(|&(_, d2)| d2.sqrt() <= limit);
+        let Some((cp, d2)) = nearest else {
+            let d = net.points.iter().map(|&q| dist(q, p.curve_point)).fold(f64::INFINITY, f64::min);
             return Err(Error::params(
                 format!("pairs[{i}].curve_point"),
                 format!(
-                    "{:?} is {:.4} from the nearest curve vertex {:?}, more than max_curve_distance ({}) \
+                    "{:?} is {d:.4e} from the nearest curve vertex, more than max_curve_distance ({}) \
                      × the curves' bounding-box diagonal ({limit:.4} in all): give a point on the curves",
-                    p.curve_point,
-                    d2.sqrt(),
-                    net.points[cp as usize],
-                    max_distance
+                    p.curve_point, max_distance
                 ),
             ));
-        }
+        };
+        snap_max = snap_max.max(d2.sqrt());
         if let Some(j) = out.iter().position(|&(_, v)| v == p.template_vertex) {
             return Err(Error::params(
                 format!("pairs[{i}].template_vertex"),

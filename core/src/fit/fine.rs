@@ -174,7 +174,7 @@ fn fine_fit_inserted(
         moved[v as usize] = net.points[p]; // exact, not RBF round-off
     }
     lap(2);
-    let mut scan = flips::detect(pos, &moved, tris);
+    let mut scan = flips::detect_polled(pos, &moved, tris, progress)?;
     let mut flagged_per_round = vec![scan.flipped.len()];
     let (mut rounds, mut faces_added) = (1, 0);
     let budget = tris.len() / 2;
@@ -187,7 +187,7 @@ fn fine_fit_inserted(
         let added = flips::subdivide(pos, tris, &scan.flipped, parents);
         let d = f.eval_many(&pos[p0..], progress)?;
         moved.extend(pos[p0..].iter().zip(d).map(|(p, d)| add(*p, d)));
-        let next = flips::detect(pos, &moved, tris);
+        let next = flips::detect_polled(pos, &moved, tris, progress)?;
         flagged_per_round.push(next.flipped.len());
         rounds += 1;
         if next.flipped.len() >= scan.flipped.len() {
@@ -276,7 +276,7 @@ fn fine_fit(
         for (p, &v) in vop.iter().enumerate() {
             moved[v as usize] = net.points[p]; // exact, not RBF round-off
         }
-        let scan = flips::detect(pos, &moved, tris);
+        let scan = flips::detect_polled(pos, &moved, tris, progress)?;
         flagged_per_round.push(scan.flipped.len());
         let n = corr.distances.len().max(1) as f64;
         let flagged = scan.flipped.clone();

@@ -41,6 +41,7 @@ pub mod retriangulate;
 pub mod smooth;
 pub mod template;
 pub mod testdata;
+pub mod thin;
 pub mod trimesh;
 pub mod untangle;
 pub mod uvs;
@@ -112,11 +113,20 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         trimesh::check_oriented_manifold_faces(&tris, Some(&face_of))?;
         Ok(tris)
     })?;
-    let template_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
+    let given_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
 
     let coarse =
         stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
+    // Distances from here on (max_curve_distance, end snaps, the relative residual) are measured
+    // on the aligned template: an alignment that scales (a template in metres, curves in
+    // centimetres) must scale the limits with it, or curves 100× larger are refused as "far"
+    // against the template's size before alignment. Except when part of the network is far from
+    // the rest (a stray curve): the alignment then stretches the template towards it, and the
+    // smaller size keeps the stray curve an error that names it.
+    let aligned_diag = Aabb::of(&pos).map(|b| b.diagonal()).unwrap_or(0.0);
+    let template_diag =
+        if net.stray_parts().is_empty() { aligned_diag } else { aligned_diag.min(given_diag) };
 
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
@@ -135,6 +145,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             params.kernel,
             levels,
             limit,
+            params.thin_rim_feet,
             progress,
         )?;
         let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
@@ -145,7 +156,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
         // One closest-point search (a BVH over the approached template) for the refinement's
         // density check and the insertion's feet; the refinement replaces it when it splits.
-        let mut search = insert::FootSearch::new(&pos, &tris)?;
+        let mut search = insert::FootSearch::new_polled(&pos, &tris, progress)?;
         let mut refined = refine::refine_near_curves(
             &mut pos,
             &mut tris,
@@ -177,6 +188,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Folds the fine deformation left (faces turned against the surface before it) are undone by
     // local edge flips and ring-mean moves of non-curve vertices.
     let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), std::mem::take(&mut tris))?;
+    // The stages after the fine one stop (too-large, naming the stage) past this many faces.
+    let face_base = crate::shapes::fan_triangles(&template.faces).len()
+        + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+    mesh.set_face_limit((params.max_face_growth * face_base as f64).min(usize::MAX as f64 / 2.0) as usize);
+    mesh.check_growth("fine")?;
     let untangle_fine = stages.run(progress, "untangle_fine", || {
         let reference = report::vertex_normals(&pos, &mesh.tris);
         let mut fixed = vec![false; pos.len()];
@@ -215,6 +231,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut realised = stages.run(progress, "retriangulate", || {
         retriangulate::realise(&mut mesh, &net, &fine.vertex_of_point, params.snap_fraction, progress)
     })?;
+    mesh.check_growth("retriangulate")?;
     let fine_parents = parents.len();
     parents.extend_from_slice(&realised.added);
     // Vertices split into crossed edges take the reference normal of their edge.
@@ -245,6 +262,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             progress,
         )
     })?;
+    mesh.check_growth("untangle_retriangulated")?;
     // Vertices those splits added: after the re-triangulation's in every per-vertex array.
     for a in &untangle_retri.added {
         parents.push(*a);
@@ -329,7 +347,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
         smoothing = stages.run(progress, "smooth", || {
-            smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)
+            let mut s = smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)?;
+            s.undone_for_flips =
+                smooth::undo_new_flips(&mut out_pos, &mesh.pos, &out_tris, &reference_normals);
+            Ok(s)
         })?;
     }
     // Smoothed vertices slid over the surface: their UVs are read where they now are.
@@ -508,6 +529,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;
+    // The guard's measure: the most faces the mesh had after the fine stage, over its base.
+    report["face_growth"] = serde_json::json!({
+        "peak_faces": mesh.peak_faces(),
+        "base": face_base,
+        "ratio": mesh.peak_faces() as f64 / face_base.max(1) as f64,
+        "limit": params.max_face_growth,
+    });
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })

@@ -115,6 +115,14 @@ pub struct FitParams {
     pub refine_dense_feet: u32,
     /// The refinement ends when no face holds more than this many dense feet (≥ 1).
     pub refine_max_feet: u32,
+    /// The fit stops with a `too-large` error, naming the stage, when its mesh grows past this ×
+    /// (template triangles + 8 × curve vertices) faces (a template that cannot follow the curves
+    /// keeps splitting: minutes of work for a useless result). Fits measured use at most ~1.2×.
+    pub max_face_growth: f64,
+    /// Approach levels move the feet of curve points lying midway between two sheets of a thin
+    /// template to its rim (`fit::thin`; report `fine.approach.rim_feet`). Off by default: it
+    /// helps some thin cases and hurts others (docs/benchmarks.md, "Thin shapes", session 8).
+    pub thin_rim_feet: bool,
 }
 
 impl Default for FitParams {
@@ -142,6 +150,8 @@ impl Default for FitParams {
             max_curve_vertices: 8000,
             refine_dense_feet: 8,
             refine_max_feet: 1,
+            max_face_growth: 4.0,
+            thin_rim_feet: false,
         }
     }
 }
@@ -178,6 +188,9 @@ impl FitParams {
         }
         if self.refine_max_feet == 0 || self.refine_max_feet > self.refine_dense_feet.max(1) {
             return bad("refine_max_feet", "must be in [1, refine_dense_feet]");
+        }
+        if !(self.max_face_growth.is_finite() && self.max_face_growth > 0.0) {
+            return bad("max_face_growth", "must be a finite number > 0");
         }
         if self.approach_levels > 6 {
             return bad("approach_levels", "must be ≤ 6");

@@ -103,7 +103,7 @@ pub fn refine_near_curves(
     for round in 0..=MAX_ROUNDS {
         progress.check()?;
         if round > 0 {
-            *search = FootSearch::new(pos, tris)?;
+            *search = FootSearch::new_polled(pos, tris, progress)?;
         }
         let (face, count) = feet_per_face(search, tris.len(), net, &dense)?;
         report.feet_per_face_max_after = count.iter().copied().max().unwrap_or(0);

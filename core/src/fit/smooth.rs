@@ -44,6 +44,9 @@ pub struct SmoothStats {
     pub moves_halved: usize,
     /// Steps given up after [`MAX_HALVINGS`] halvings (the vertex stayed put that iteration).
     pub moves_rejected: usize,
+    /// Vertices put back where they were before smoothing because a face of theirs ended turned
+    /// against the reference surface ([`undo_new_flips`]).
+    pub undone_for_flips: usize,
 }
 
 /// Halvings of a failing step before the vertex is left where it was.
@@ -235,6 +238,65 @@ pub fn smooth(
     Ok(stats)
 }
 
+/// Is the face at `pos` turned against the sum of its corners' `reference` normals (negative),
+/// degenerate (zero) or right (positive)? The report's `flipped_faces` test.
+fn orientation(pos: &[Point3], t: [u32; 3], reference: &[Point3]) -> f64 {
+    let r = t.iter().fold([0.0; 3], |acc, &v| add(acc, reference[v as usize]));
+    dot(face_normal(pos, t), r)
+}
+
+/// Puts back to `before` (the positions before smoothing) every moved corner of a face that the
+/// smoothing turned against the `reference` vertex normals (or made degenerate) while it was
+/// right before, and repeats on the faces that changes, until no face is worse than before (a face
+/// thinner than the thinnest before smoothing counts as worse: a corner put back next to
+/// neighbours that stay smoothed must not make one). Returns how many vertices were put back.
+///
+/// Why: the flows' guard ([`commit_safely`]) compares each step with the face's normal before
+/// that step, so a face can turn by small steps over many iterations until it faces away from
+/// the surface (a 20k-face icosphere fitted through 90° arcs: 0 flipped faces before smoothing,
+/// 1 after, and the untangling after smoothing did not unfold it). Terminates: every round puts
+/// back at least one vertex, and a face whose corners are all put back is as it was.
+pub fn undo_new_flips(
+    pos: &mut [Point3],
+    before: &[Point3],
+    tris: &[[u32; 3]],
+    reference: &[Point3],
+) -> usize {
+    // A corner put back next to neighbours that stay smoothed could make a face thinner than any
+    // before smoothing: such a face counts as worse too, so the smallest angle never drops.
+    let quality =
+        |p: &[Point3], t: [u32; 3]| min_angle_quality(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
+    let floor = tris.iter().map(|&t| quality(before, t)).fold(f64::INFINITY, f64::min);
+    let mut undone = 0;
+    loop {
+        let mut changed = 0;
+        for &t in tris {
+            if t.iter().all(|&v| pos[v as usize] == before[v as usize]) {
+                continue;
+            }
+            let (now, was) = (orientation(pos, t, reference), orientation(before, t, reference));
+            let turned = (now < 0.0 && was >= 0.0) || (now == 0.0 && was > 0.0);
+            let worse = turned || {
+                let q = quality(pos, t);
+                q < floor && q < quality(before, t)
+            };
+            if !worse {
+                continue;
+            }
+            for &v in &t {
+                if pos[v as usize] != before[v as usize] {
+                    pos[v as usize] = before[v as usize];
+                    changed += 1;
+                }
+            }
+        }
+        if changed == 0 {
+            return undone;
+        }
+        undone += changed;
+    }
+}
+
 /// sin² of a face's smallest angle (the corner opposite the shortest edge): |n|² / (|e1|²·|e2|²)
 /// with e1, e2 the two longer edges. Monotone in the angle on [0°, 60°], where a smallest angle
 /// always is, and free of trigonometry. 0 for a degenerate face.
@@ -421,6 +483,64 @@ mod tests {
     use super::*;
     use crate::geometry::norm;
     use crate::shapes::icosphere;
+
+    #[test]
+    fn a_face_the_smoothing_turned_over_gets_its_moved_corners_back() {
+        // Square A(-1,-1) B(1,-1) C(1,1) D(-1,1) around E(0,0), and F(3,0) beyond B–C, all in
+        // z = 0 with reference normals +z. Smoothed: E went to (1.5, 0), past the edge B–C, so
+        // (B, C, E) turned over (hand: cross((0,2),(0.5,1)) = −1); F went to (2.8, 0), and its
+        // face (B, F, C) stays right and fatter (smallest angle 53° → 58°). Only E goes back.
+        let before = vec![
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
+        let tris = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [1, 5, 2]];
+        let reference = vec![[0.0, 0.0, 1.0]; 6];
+        let mut pos = before.clone();
+        pos[4] = [1.5, 0.0, 0.0];
+        pos[5] = [2.8, 0.0, 0.0];
+        assert!(orientation(&pos, tris[1], &reference) < 0.0);
+        assert_eq!(undo_new_flips(&mut pos, &before, &tris, &reference), 1);
+        assert_eq!(pos[4], before[4]);
+        assert_eq!(pos[5], [2.8, 0.0, 0.0]);
+        // A face already turned over before smoothing is not the smoothing's doing: left alone
+        // (E from (1.5, 0) to (1.45, 0): no face thinner than the thinnest before, 21.8°).
+        let mut before2 = before.clone();
+        before2[4] = [1.5, 0.0, 0.0];
+        let mut pos2 = before2.clone();
+        pos2[4] = [1.45, 0.0, 0.0];
+        assert_eq!(undo_new_flips(&mut pos2, &before2, &tris, &reference), 0);
+        assert_eq!(pos2[4], [1.45, 0.0, 0.0]);
+        // F pushed out to (3.5, 0) instead makes (B, F, C) thinner (43.6° at F) than the thinnest
+        // face before (45°): it goes back too.
+        let mut pos3 = before.clone();
+        pos3[4] = [1.5, 0.0, 0.0];
+        pos3[5] = [3.5, 0.0, 0.0];
+        assert_eq!(undo_new_flips(&mut pos3, &before, &tris, &reference), 2);
+        assert_eq!(pos3, before);
+    }
+
+    #[test]
+    fn undoing_a_corner_that_turns_a_neighbour_over_undoes_the_neighbour_too() {
+        // Vertices 0 (0,0), 1 (1,1), 2 (2,0), 3 (3,1) in z = 0, reference +z; faces Y = (1,2,3)
+        // (listed first, so the scan meets it before X) and X = (0,2,1). Smoothed: 1 → (1,−0.5),
+        // 3 → (1.5, 0). Hand values (z of the cross products): X = cross((2,0),(1,−0.5)) = −1,
+        // turned over; Y = cross((1,0.5),(0.5,0.5)) = 0.25, right. Round 1 puts 1 back; then
+        // Y = cross((1,−1),(0.5,−1)) = −0.5, turned over, so round 2 puts 3 back.
+        let before = vec![[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0], [3.0, 1.0, 0.0]];
+        let tris = [[1, 2, 3], [0, 2, 1]];
+        let reference = vec![[0.0, 0.0, 1.0]; 4];
+        let mut pos = before.clone();
+        pos[1] = [1.0, -0.5, 0.0];
+        pos[3] = [1.5, 0.0, 0.0];
+        assert!(orientation(&pos, tris[0], &reference) > 0.0 && orientation(&pos, tris[1], &reference) < 0.0);
+        assert_eq!(undo_new_flips(&mut pos, &before, &tris, &reference), 2);
+        assert_eq!(pos, before);
+    }
 
     #[test]
     fn tangential_flows_keep_a_sphere_and_fixed_vertices() {

@@ -77,6 +77,11 @@ pub struct TriMesh {
     pub alive: Vec<bool>,
     half: IntMap<(u32, u32), u32>,
     vfaces: Vec<Vec<u32>>,
+    /// Live faces (what `alive` counts), and the most the fit lets its stages make
+    /// ([`TriMesh::check_growth`]).
+    live: usize,
+    peak: usize,
+    face_limit: usize,
 }
 
 impl TriMesh {
@@ -89,6 +94,9 @@ impl TriMesh {
             alive: vec![true; tris.len()],
             half: IntMap::with_capacity_and_hasher(tris.len() * 3, Default::default()),
             tris: Vec::with_capacity(tris.len()),
+            live: tris.len(),
+            peak: tris.len(),
+            face_limit: usize::MAX,
         };
         for (fi, t) in tris.iter().enumerate() {
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
@@ -130,6 +138,8 @@ impl TriMesh {
         }
         self.tris.push(t);
         self.alive.push(true);
+        self.live += 1;
+        self.peak = self.peak.max(self.live);
         Ok(fi)
     }
 
@@ -139,6 +149,7 @@ impl TriMesh {
         }
         let t = self.tris[f as usize];
         self.alive[f as usize] = false;
+        self.live -= 1;
         for k in 0..3 {
             self.half.remove(&(t[k], t[(k + 1) % 3]));
             let list = &mut self.vfaces[t[k] as usize];
@@ -211,6 +222,40 @@ impl TriMesh {
             n = add(n, self.face_normal(f));
         }
         normalize(n)
+    }
+
+    /// Number of live faces.
+    pub fn live_faces(&self) -> usize {
+        self.live
+    }
+
+    /// The most live faces the mesh had at once.
+    pub fn peak_faces(&self) -> usize {
+        self.peak
+    }
+
+    /// The face count above which [`TriMesh::check_growth`] fails (the fit's `max_face_growth`).
+    pub fn set_face_limit(&mut self, limit: usize) {
+        self.face_limit = limit;
+    }
+
+    /// Fails when the mesh has grown past its face limit, naming the stage: a stage that keeps
+    /// splitting (curves the template cannot follow, e.g. a round template on a thin target:
+    /// 1,280 → 600k faces and minutes of work before the guard) stops at its next poll instead.
+    pub fn check_growth(&self, stage: &str) -> Result<()> {
+        if self.live <= self.face_limit {
+            return Ok(());
+        }
+        Err(Error::TooLarge {
+            what: format!(
+                "faces of the fitted mesh in stage `{stage}` (limit: max_face_growth × (template \
+                 triangles + 8 × curve vertices)): the template cannot follow the curves there (a \
+                 template far from the curves' shape, e.g. round against a thin target?); give pairs, \
+                 a template closer to the target, or raise max_face_growth"
+            ),
+            limit: self.face_limit as u64,
+            actual: self.live as u64,
+        })
     }
 
     pub fn alive_faces(&self) -> impl Iterator<Item = u32> + '_ {

@@ -489,28 +489,8 @@ mod tests {
     use super::*;
     use crate::mesh::Faces;
     use crate::shapes;
+    use crate::shapes::icosphere_without_cap as capped;
     use crate::validate::analyze;
-
-    /// Icosphere with the faces around the north pole (within `deg` degrees) removed.
-    fn capped(level: u32, deg: f64) -> (Mesh, f64) {
-        let m = shapes::icosphere(level, 1.0);
-        let cos = deg.to_radians().cos();
-        let mut removed = 0.0;
-        let mut faces = Faces::new();
-        for f in m.faces.iter() {
-            let c = f.iter().map(|&v| m.positions[v as usize][2]).sum::<f64>() / 3.0;
-            if c > cos {
-                removed += triangle_area(
-                    m.positions[f[0] as usize],
-                    m.positions[f[1] as usize],
-                    m.positions[f[2] as usize],
-                );
-            } else {
-                faces.push(f, 0);
-            }
-        }
-        (Mesh::new(m.positions, faces), removed)
-    }
 
     #[test]
     fn cap_is_filled_closed_with_matching_area() {

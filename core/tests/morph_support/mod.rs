@@ -72,3 +72,32 @@ pub fn spherical_area(a: Point3, b: Point3, c: Point3) -> f64 {
     let den = 1.0 + dot(a, b) + dot(b, c) + dot(c, a);
     2.0 * num.atan2(den)
 }
+
+/// The unit icosphere of `levels` scaled by `axes`: an ellipsoid with the sphere's connectivity.
+pub fn ellipsoid(levels: u32, axes: Point3) -> Mesh {
+    let mut m = meshwork_core::shapes::icosphere(levels, 1.0);
+    for p in &mut m.positions {
+        *p = [p[0] * axes[0], p[1] * axes[1], p[2] * axes[2]];
+    }
+    m
+}
+
+/// An n×n grid on [−1, 1]² pushed radially onto the unit disk (square rings → circles), z = 0.
+pub fn disk(n: usize) -> Mesh {
+    let mut m = meshwork_core::shapes::grid(n, n, 2.0 / n as f64, false);
+    for p in &mut m.positions {
+        let (x, y) = (p[0] - 1.0, p[1] - 1.0);
+        let r = x.abs().max(y.abs());
+        let l = x.hypot(y);
+        let f = if l > 0.0 { r / l } else { 0.0 };
+        *p = [x * f, y * f, 0.0];
+    }
+    m
+}
+
+/// The vertex of `m` farthest along direction `d` (feature pairs at the tips of a shape).
+pub fn extreme_vertex(m: &Mesh, d: Point3) -> u32 {
+    (0..m.positions.len())
+        .max_by(|&i, &j| dot(m.positions[i], d).total_cmp(&dot(m.positions[j], d)))
+        .expect("a mesh with vertices") as u32
+}

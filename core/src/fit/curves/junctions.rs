@@ -470,24 +470,30 @@ impl Builder {
                     self.stats.junction_max_gap = self.stats.junction_max_gap.max(gap);
                 }
                 (Some(v), Some(w)) => {
-                    // Both near a vertex: two curves meet at a point each samples separately.
+                    // Both near a vertex: two curves meet at a point each samples separately,
+                    // or two curves cross near a sample of each.
                     if adj(v, w) {
                         continue;
                     }
-                    if dist(p(v), p(w)) > allowed {
-                        // Each end is near the crossing but not near each other (a shallow
-                        // crossing, whose point slides along both segments): the vertex
-                        // nearer the other segment splits it, as a crossing at a vertex.
-                        let into = |x: u32, o: [u32; 2]| {
-                            let u = segment_param(p(x), p(o[0]), p(o[1]));
-                            let gap = dist(p(x), lerp(p(o[0]), p(o[1]), u));
-                            (gap, u, x, o)
-                        };
-                        let (gap, u, x, o) = [into(v, s2), into(w, s1)]
-                            .into_iter()
-                            .min_by(|a, b| a.0.total_cmp(&b.0))
-                            .unwrap_or(into(v, s2));
-                        if gap > allowed || u <= 0.0 || u >= 1.0 || adj(x, o[0]) || adj(x, o[1]) {
+                    let into = |x: u32, o: [u32; 2]| {
+                        let u = segment_param(p(x), p(o[0]), p(o[1]));
+                        let gap = dist(p(x), lerp(p(o[0]), p(o[1]), u));
+                        (gap, u, x, o)
+                    };
+                    let (gap, u, x, o) = [into(v, s2), into(w, s1)]
+                        .into_iter()
+                        .min_by(|a, b| a.0.total_cmp(&b.0))
+                        .unwrap_or(into(v, s2));
+                    let apart = dist(p(v), p(w));
+                    // A split (the vertex nearer the other segment put into it) moves a curve by
+                    // `gap`, a merge by `apart`. Split when the vertices are far apart (a shallow
+                    // crossing, whose point slides along both segments) or when one vertex lies on
+                    // the other segment much closer than the two vertices are to each other (two
+                    // curves closer than a quarter segment, e.g. two parallels crossed by a
+                    // meridian: merging would pinch one onto the other at every crossing).
+                    let split_ok = gap <= allowed && u > 0.0 && u < 1.0 && !adj(x, o[0]) && !adj(x, o[1]);
+                    if apart > allowed || (4.0 * gap <= apart && split_ok) {
+                        if !split_ok {
                             continue;
                         }
                         splits.entry(key(o[0], o[1])).or_default().push((u, x));
@@ -495,11 +501,10 @@ impl Builder {
                         self.stats.junction_max_gap = self.stats.junction_max_gap.max(gap);
                         continue;
                     }
-                    let gap = dist(p(v), p(w));
                     if m.merge(w, v) {
                         merged_any = true;
                         self.stats.crossings_at_vertices += 1;
-                        self.stats.junction_max_gap = self.stats.junction_max_gap.max(gap);
+                        self.stats.junction_max_gap = self.stats.junction_max_gap.max(apart);
                     }
                 }
             }

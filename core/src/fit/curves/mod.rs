@@ -78,8 +78,11 @@ impl Default for NetworkOptions {
 pub struct NetworkStats {
     pub input_polylines: usize,
     pub input_points: usize,
-    /// Input points merged into an equal (within `join_tolerance`) point.
+    /// Input points merged into an equal (within `join_tolerance`) point, and the largest
+    /// distance such a point moved (shared ends written by different node transforms of a glTF
+    /// file differ by f32 rounding; the output carries the welded position).
     pub welded_points: usize,
+    pub welded_max_distance: f64,
     /// Consecutive repeated points removed.
     pub zero_length_segments: usize,
     /// Input polylines dropped because they have fewer than two distinct points.
@@ -182,6 +185,7 @@ impl CurveNetwork {
             ));
         }
         stats.welded_points = inputs_seen - weld.points.len();
+        stats.welded_max_distance = weld.max_moved;
         let mut b = Builder { points: weld.points, polylines, stats };
         b.merge_near_duplicates(opt.merge_tolerance);
         if opt.junction_tolerance > 0.0 {
@@ -265,13 +269,15 @@ impl CurveNetwork {
 /// Merges points closer than `tol` (hash grid with cell = tol, 27-cell lookup).
 struct Weld {
     tol: f64,
+    /// Largest distance from an input point to the point it was welded into.
+    max_moved: f64,
     points: Vec<Point3>,
     cells: HashMap<[i64; 3], Vec<u32>>,
 }
 
 impl Weld {
     fn new(tol: f64) -> Self {
-        Weld { tol, points: Vec::new(), cells: HashMap::new() }
+        Weld { tol, max_moved: 0.0, points: Vec::new(), cells: HashMap::new() }
     }
 
     fn cell(&self, p: Point3) -> [i64; 3] {
@@ -285,7 +291,9 @@ impl Weld {
                 for dz in -1..=1 {
                     if let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
                         for &i in list {
-                            if dist(self.points[i as usize], p) <= self.tol {
+                            let d = dist(self.points[i as usize], p);
+                            if d <= self.tol {
+                                self.max_moved = self.max_moved.max(d);
                                 return i;
                             }
                         }

@@ -17,7 +17,9 @@
 //! passes near. Walks start afresh at every anchor (feature point, curve end, user pair), whose
 //! own closest point is kept.
 
+use crate::error::Result;
 use crate::geometry::dist;
+use crate::job::Progress;
 use crate::mesh::Point3;
 use crate::spatial::closest_on_triangle;
 
@@ -35,12 +37,14 @@ pub fn walk_feet(
     net: &CurveNetwork,
     feet: &mut [(u32, Point3, f64)],
     anchor: &[bool],
-) -> usize {
-    walk_feet_directed(pos, tris, vf, net, feet, anchor, false)
+    progress: &Progress,
+) -> Result<usize> {
+    walk_feet_directed(pos, tris, vf, net, feet, anchor, false, progress)
 }
 
 /// [`walk_feet`] along each polyline's order, or against it (`backward`): a walk that went
 /// astray from one side is caught by the other side's disagreeing (the approach levels use both).
+#[allow(clippy::too_many_arguments)]
 pub fn walk_feet_directed(
     pos: &[Point3],
     tris: &[[u32; 3]],
@@ -49,12 +53,14 @@ pub fn walk_feet_directed(
     feet: &mut [(u32, Point3, f64)],
     anchor: &[bool],
     backward: bool,
-) -> usize {
+    progress: &Progress,
+) -> Result<usize> {
     let mut changed = 0;
     let mut done = vec![false; net.points.len()];
     let mut seen = SeenFaces::new(tris.len());
     let mut heap = std::collections::BinaryHeap::new();
     let mut reversed: Vec<u32> = Vec::new();
+    let mut walks = 0;
     for line in &net.polylines {
         let line: &[u32] = if backward {
             reversed.clear();
@@ -64,6 +70,9 @@ pub fn walk_feet_directed(
             line
         };
         for w in line.windows(2) {
+            // A walk searches up to a ball of faces: a poll every 256 walks is a few ms.
+            walks += 1;
+            progress.check_every(walks, 256)?;
             let (p0, p) = (w[0] as usize, w[1] as usize);
             if anchor[p] || done[p] {
                 continue;
@@ -84,7 +93,7 @@ pub fn walk_feet_directed(
             }
         }
     }
-    changed
+    Ok(changed)
 }
 
 /// Component of each face, numbered from 0 in face order (faces sharing a vertex are connected,
@@ -204,4 +213,65 @@ fn nearest_connected(
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+
+    /// A straight run of `n` points 0.03 above the lower sheet of the two-sheet plate, its
+    /// network, its feet (closest points) and the plate's vertex-face lists.
+    fn run_over_plate(
+        n: usize,
+    ) -> (Vec<Point3>, Vec<[u32; 3]>, Vec<Vec<u32>>, CurveNetwork, Vec<(u32, Point3, f64)>) {
+        let (pos, tris) = crate::fit::insert::tests::two_sheet_plate();
+        let mut vf = vec![Vec::new(); pos.len()];
+        for (f, t) in tris.iter().enumerate() {
+            for &v in t {
+                vf[v as usize].push(f as u32);
+            }
+        }
+        let pts: Vec<Point3> = (0..n).map(|k| [0.05 + 0.9 * k as f64 / (n - 1) as f64, 0.45, 0.03]).collect();
+        let curves = crate::mesh::Mesh {
+            positions: pts.clone(),
+            curves: vec![(0..n as u32).collect()],
+            ..Default::default()
+        };
+        let net = CurveNetwork::from_mesh(&curves, 1e-9).unwrap();
+        let all: Vec<u32> = (0..net.points.len() as u32).collect();
+        let feet = crate::fit::insert::feet(&pos, &tris, &net.points, &all).unwrap();
+        (pos, tris, vf, net, feet)
+    }
+
+    /// One walk per curve segment, each searching up to 20,000 faces, and ~2,000 of them per
+    /// level on the headline: a poll every 256 walks. A 1,000-point run has 999 walks per
+    /// direction: polls at walks 256, 512 and 768, three each way; a cancel stops the walks.
+    #[test]
+    fn walks_poll_every_256_segments_and_stop_at_a_cancel() {
+        let (pos, tris, vf, net, feet) = run_over_plate(1000);
+        assert_eq!(net.polylines.len(), 1);
+        assert_eq!(net.polylines[0].len(), 1000, "the case: one run of 1,000 points");
+        let anchor: Vec<bool> = net.degree.iter().map(|&d| d != 2).collect();
+        for backward in [false, true] {
+            let p = Progress::new();
+            let mut walked = feet.clone();
+            let changed =
+                walk_feet_directed(&pos, &tris, &vf, &net, &mut walked, &anchor, backward, &p).unwrap();
+            assert_eq!(p.checks(), 3, "backward {backward}");
+            // Every point is nearest the lower sheet: the walks keep the closest points.
+            assert_eq!(changed, 0);
+            assert!(walked.iter().all(|f| f.1[2] == 0.0));
+            let p = Progress::new();
+            p.cancel_at_check(2);
+            let mut walked = feet.clone();
+            let r = walk_feet_directed(&pos, &tris, &vf, &net, &mut walked, &anchor, backward, &p);
+            assert!(matches!(r, Err(Error::Cancelled)), "backward {backward}");
+            assert_eq!(p.checks(), 2);
+        }
+        let p = Progress::new();
+        let mut walked = feet.clone();
+        walk_feet(&pos, &tris, &vf, &net, &mut walked, &anchor, &p).unwrap();
+        assert_eq!(p.checks(), 3);
+    }
 }

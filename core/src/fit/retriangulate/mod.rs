@@ -94,6 +94,7 @@ pub fn realise(
     for (k, &(si, walk)) in pending.iter().enumerate() {
         if k % 64 == 0 {
             progress.fraction(0.8 + 0.2 * k as f64 / pending.len() as f64)?;
+            work.mesh.check_growth("retriangulate")?;
         }
         let seg = net.segments[si];
         let (u, w) = (vertex_of_point[seg[0] as usize], vertex_of_point[seg[1] as usize]);
@@ -119,6 +120,7 @@ fn walk_all(
     for (si, seg) in net.segments.iter().enumerate() {
         if si % 256 == 0 {
             progress.fraction(0.8 * si as f64 / net.segments.len().max(1) as f64)?;
+            work.mesh.check_growth("retriangulate")?;
         }
         let (u, w) = (vertex_of_point[seg[0] as usize], vertex_of_point[seg[1] as usize]);
         let mut chain = vec![u];

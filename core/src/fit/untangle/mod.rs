@@ -165,6 +165,7 @@ pub fn untangle_with_splits(
         // Each round clones the mesh and untangles it again: on a 100k-vertex template that is
         // long enough for a cancel to be noticed between rounds.
         progress.check()?;
+        mesh.check_growth("untangle")?;
         // A round is kept only when it leaves fewer folds (a split whose ring has no place that
         // sees all its edges, e.g. around crossing fixed curve vertices, only adds faces).
         let snapshot = (mesh.clone(), stats.clone(), reference.len());
