@@ -99,7 +99,7 @@ pub fn approach(
     if sizes.is_empty() {
         return Ok(report);
     }
-    let mut vf = super::field_refine::faces_around(pos.len(), tris);
+    let mut vf = super::insert::vertex_faces(pos.len(), tris);
     let is_fixed_point = {
         let mut m = vec![false; net.points.len()];
         for &(p, _) in fixed {
@@ -187,7 +187,7 @@ pub fn approach(
             pos, tris, parents, &mut disp, &field, &targets, &feet, gate, progress,
         )?;
         if refined.faces_added > 0 {
-            vf = super::field_refine::faces_around(pos.len(), tris);
+            vf = super::insert::vertex_faces(pos.len(), tris);
         }
         report.refined.push(refined);
         let mut step = 1.0;

@@ -134,17 +134,6 @@ fn samples_over(
     (over, worst)
 }
 
-/// Face lists of every vertex.
-pub fn faces_around(nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    for (f, t) in tris.iter().enumerate() {
-        for &v in t {
-            vf[v as usize].push(f as u32);
-        }
-    }
-    vf
-}
-
 /// Faces with an edge (longer than `min_edge`) whose midpoint deviation exceeds `tolerance`, and
 /// the largest deviation seen.
 fn deviating_faces(

@@ -101,8 +101,11 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             actual: net.points.len() as u64,
         });
     }
+    // The template's triangles, fanned once: the working copy below starts from them, and the
+    // face-growth base, the group transfer and the report measure them.
+    let template_tris = crate::shapes::fan_triangles(&template.faces);
     let mut tris = stages.run(progress, "validate", || {
-        let tris = crate::shapes::fan_triangles(&template.faces);
+        let tris = template_tris.clone();
         if tris.is_empty() {
             return Err(Error::params("template", "the template has no faces"));
         }
@@ -189,8 +192,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // local edge flips and ring-mean moves of non-curve vertices.
     let mut mesh = trimesh::TriMesh::new(fine.positions.clone(), std::mem::take(&mut tris))?;
     // The stages after the fine one stop (too-large, naming the stage) past this many faces.
-    let face_base = crate::shapes::fan_triangles(&template.faces).len()
-        + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+    let face_base = template_tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
     mesh.set_face_limit((params.max_face_growth * face_base as f64).min(usize::MAX as f64 / 2.0) as usize);
     mesh.check_growth("fine")?;
     let untangle_fine = stages.run(progress, "untangle_fine", || {
@@ -205,10 +207,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
     // The template's own face groups, when it has several, are intersected with the regions.
     let keep_groups = template.groups.len() > 1
-        && template.faces.iter().map(|f| f.len().saturating_sub(2)).sum::<usize>()
-            == crate::shapes::fan_triangles(&template.faces).len();
+        && template.faces.iter().map(|f| f.len().saturating_sub(2)).sum::<usize>() == template_tris.len();
     let fine_groups = if keep_groups {
-        let template_tris = crate::shapes::fan_triangles(&template.faces);
         let template_groups: Vec<u32> = (0..template.faces.len())
             .flat_map(|i| {
                 std::iter::repeat_n(template.faces.group(i), template.faces.arity(i).saturating_sub(2))
@@ -469,7 +469,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "fold_angle_deg": untangle::FOLD_ANGLE_DEG,
         "output": folds,
         "before_smoothing": folds_before_smoothing,
-        "template": untangle::fold_stats(&template.positions, &crate::shapes::fan_triangles(&template.faces)),
+        "template": untangle::fold_stats(&template.positions, &template_tris),
     });
     // Every vertex moved over the surface (its UV re-read where it landed), in the numbering
     // before the clean-up: re-triangulation snaps, untangling, smoothing.
@@ -483,7 +483,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut report = serde_json::json!({
         "template_vertices": template.vertex_count() + unreferenced,
         "template_faces": template.face_count(),
-        "template_triangles": crate::shapes::fan_triangles(&template.faces).len(),
+        "template_triangles": template_tris.len(),
         "template_unreferenced_vertices_removed": unreferenced,
         "template_groups_kept": if keep_groups { template.groups.len() } else { 0 },
         "output_vertices": out.vertex_count(),

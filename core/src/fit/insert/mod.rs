@@ -133,8 +133,8 @@ pub fn insert_curve_points(
     Ok(Inserted { vertex_of_point: vop, created_in, stats })
 }
 
-/// Faces around each vertex.
-fn vertex_faces(nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
+/// Faces around each vertex (the approach and the field refinement use it too).
+pub(super) fn vertex_faces(nv: usize, tris: &[[u32; 3]]) -> Vec<Vec<u32>> {
     let mut vf: Vec<Vec<u32>> = vec![Vec::new(); nv];
     for (f, t) in tris.iter().enumerate() {
         for &v in t {
