@@ -9,7 +9,7 @@ use super::dijkstra::{dijkstra_project, Projected};
 use super::snap::{closest_on_segment, keeps_orientation};
 use super::split::split_crossings;
 use super::stats::{detour, FailedSegment, Fallback};
-use super::{lock_chain, route, Work};
+use super::{lock_chain, off_surface, route, Work};
 
 /// Largest number of faces the route fallback settles for one segment.
 const ROUTE_BUDGET: usize = 1_000_000;
@@ -28,7 +28,11 @@ impl Work<'_> {
         let from = *chain.last().unwrap_or(&u);
         let seg_ends = (self.mesh.pos[u as usize], self.mesh.pos[w as usize]);
         let n0 = chain.len();
-        match self.fallback(from, w, seg_ends, chain) {
+        // A segment over a gap of the template has no chain; a fallback would go around the gap.
+        let over_gap = off_surface::is_off_surface(self.mesh, u, w);
+        let result =
+            if over_gap { Err(route::NoRoute::Separated) } else { self.fallback(from, w, seg_ends, chain) };
+        match result {
             Ok(m) => {
                 let d = detour(self.mesh, &chain[n0 - 1..]);
                 self.stats.record_fallback(si, m, d);
@@ -36,8 +40,10 @@ impl Work<'_> {
             }
             Err(why) => {
                 // A separated segment whose ends no edge path joins at all cannot be a chain.
-                let pieces = why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
+                let pieces =
+                    !over_gap && why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
                 self.stats.failed_pieces += usize::from(pieces);
+                self.stats.off_surface_segments += usize::from(over_gap);
                 if self.stats.failed.len() < 20 {
                     self.stats.failed.push(FailedSegment {
                         segment: si,
@@ -46,6 +52,7 @@ impl Work<'_> {
                         stopped_at: from,
                         walk,
                         route: match why {
+                            _ if over_gap => "off_surface",
                             _ if pieces => "pieces",
                             route::NoRoute::Separated => "separated",
                             route::NoRoute::Budget => "budget",
