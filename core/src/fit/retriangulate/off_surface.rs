@@ -10,7 +10,8 @@
 //! apart (`off_surface_segments`): the regions on either side of the curve stay apart anyway,
 //! since the chains on both sides of the gap end on the rim.
 //!
-//! The test: points along the segment whose nearest point on the surface around it lies on a
+//! The test (the caller, `fallback.rs`, also asks for both ends on the rim and no route across
+//! faces within `LONG_DETOUR` × the ends' distance): points along the segment whose nearest point on the surface around it lies on a
 //! boundary edge, farther than [`OFF_FRACTION`] of the segment's length. A segment over the surface
 //! (ends on it after the fine stage) is within its sagitta of it, with the nearest point inside a
 //! face; only a segment whose chord leaves the surface over its rim has a far nearest point on
