@@ -17,6 +17,7 @@ pub const Z: Point3 = [0.0, 0.0, 1.0];
 pub const O: Point3 = [0.0, 0.0, 0.0];
 
 /// What a case expects.
+#[derive(Debug)]
 pub enum Expect {
     /// A fit with this many regions (None: no hand count).
     Fit(Option<usize>),
