@@ -67,7 +67,8 @@ fn listing(c: &Case) -> String {
         Ok(meshes) => {
             let mut h = std::collections::hash_map::DefaultHasher::new();
             format!("{meshes:?}").hash(&mut h);
-            let counts: Vec<_> = meshes.iter().map(|m| (m.positions.len(), m.faces.len(), m.curves.len())).collect();
+            let counts: Vec<_> =
+                meshes.iter().map(|m| (m.positions.len(), m.faces.len(), m.curves.len())).collect();
             format!("{:016x} {counts:?}", h.finish())
         }
         Err(e) => format!("error {e}"),
