@@ -71,9 +71,19 @@ pub fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
     // touch): accepted only when the template is in several pieces (counted here) and the report
     // names every unrealised segment as such (`failed_pieces`; counts against a geometric truth
     // are in tests/fit_unseen_pieces.rs).
+    // A segment over a hole of the template has no surface under it: accepted only when the
+    // report's `off_surface_segments` equals the count of curve segments whose middle is off the
+    // output surface (counted here on the output; hand counts in tests/fit_hole.rs).
     let failed = r["retriangulation"]["failed_segments"].as_u64().unwrap_or(0);
     let pieces = r["retriangulation"]["failed_pieces"].as_u64().unwrap_or(0);
-    let honest = failed > 0 && failed == pieces && edge_pieces(template) > 1;
+    let off = r["retriangulation"]["off_surface_segments"].as_u64().unwrap_or(0);
+    if off > 0 {
+        let counted = segments_off_output(curves, m);
+        if counted != off as usize {
+            bad.push(format!("{off} segments reported off the surface, {counted} counted"));
+        }
+    }
+    let honest = failed > 0 && failed == pieces + off && (pieces == 0 || edge_pieces(template) > 1);
     if r["segments_as_edges"].as_f64() != Some(1.0) && !honest {
         bad.push(format!("segments_as_edges {}", r["segments_as_edges"]));
     }
@@ -81,6 +91,30 @@ pub fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
         bad.push(format!("flipped {}", r["flipped_faces"]));
     }
     bad
+}
+
+/// Curve segments (consecutive polyline points) whose middle is farther than 0.1 × their length
+/// from every face of `m`: the segments over a hole of the surface.
+fn segments_off_output(curves: &Mesh, m: &Mesh) -> usize {
+    let tris = m.faces.triangles();
+    let p = |v: u32| curves.positions[v as usize];
+    curves
+        .curves
+        .iter()
+        .flat_map(|l| l.windows(2))
+        .filter(|s| {
+            let (a, b) = (p(s[0]), p(s[1]));
+            let mid = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0];
+            let d = tris
+                .iter()
+                .map(|t| {
+                    let c = t.map(|v| m.positions[v as usize]);
+                    norm(sub(mid, meshwork_core::spatial::closest_on_triangle(mid, &c)))
+                })
+                .fold(f64::INFINITY, f64::min);
+            d > 0.1 * norm(sub(b, a))
+        })
+        .count()
 }
 
 /// Pieces of a mesh joined through shared edges, vertices welded by exact position first.

@@ -150,7 +150,9 @@ fn main() {
                     );
                     eprintln!("  stages {}; fine {}", r["stages"], r["fine"]);
                 }
+                let off = r["retriangulation"]["off_surface_segments"].as_u64().unwrap_or(0);
                 let status = match (bad.is_empty(), r["retriangulation"]["failed_pieces"].as_u64()) {
+                    (true, _) if off > 0 => format!("ok ({off} segments over a hole)"),
                     (true, Some(n)) if n > 0 => format!("ok ({n} segments between unjoined pieces)"),
                     (true, _) => "ok".to_string(),
                     _ => format!("BAD {}", bad.join("; ")),

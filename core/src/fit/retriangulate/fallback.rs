@@ -9,7 +9,7 @@ use super::dijkstra::{dijkstra_project, Projected};
 use super::snap::{closest_on_segment, keeps_orientation};
 use super::split::split_crossings;
 use super::stats::{detour, FailedSegment, Fallback};
-use super::{lock_chain, route, Work};
+use super::{lock_chain, off_surface, route, Work};
 
 /// Largest number of faces the route fallback settles for one segment.
 const ROUTE_BUDGET: usize = 1_000_000;
@@ -28,7 +28,11 @@ impl Work<'_> {
         let from = *chain.last().unwrap_or(&u);
         let seg_ends = (self.mesh.pos[u as usize], self.mesh.pos[w as usize]);
         let n0 = chain.len();
-        match self.fallback(from, w, seg_ends, chain) {
+        // A segment over a gap of the template has no chain; a fallback would go around the gap.
+        let over_gap = self.goes_around_a_gap(u, w, from, seg_ends);
+        let result =
+            if over_gap { Err(route::NoRoute::Separated) } else { self.fallback(from, w, seg_ends, chain) };
+        match result {
             Ok(m) => {
                 let d = detour(self.mesh, &chain[n0 - 1..]);
                 self.stats.record_fallback(si, m, d);
@@ -36,8 +40,10 @@ impl Work<'_> {
             }
             Err(why) => {
                 // A separated segment whose ends no edge path joins at all cannot be a chain.
-                let pieces = why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
+                let pieces =
+                    !over_gap && why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
                 self.stats.failed_pieces += usize::from(pieces);
+                self.stats.off_surface_segments += usize::from(over_gap);
                 if self.stats.failed.len() < 20 {
                     self.stats.failed.push(FailedSegment {
                         segment: si,
@@ -46,6 +52,7 @@ impl Work<'_> {
                         stopped_at: from,
                         walk,
                         route: match why {
+                            _ if over_gap => "off_surface",
                             _ if pieces => "pieces",
                             route::NoRoute::Separated => "separated",
                             route::NoRoute::Budget => "budget",
@@ -54,6 +61,37 @@ impl Work<'_> {
                 }
                 self.stats.failed_segments += 1;
                 chain.push(w);
+            }
+        }
+    }
+
+    /// Whether segment u–w (walked up to `from`) crosses a gap of the template, so that any
+    /// fallback would go around it: both ends on the rim, the straight way off the surface over
+    /// the rim ([`off_surface`]), and no route across faces at most [`super::LONG_DETOUR`] × the
+    /// ends' distance. (A segment just past the rim of a misaligned open template, with a short
+    /// way along the rim, keeps its fallback: measured on woody `auto` and the bunny's pairs.)
+    fn goes_around_a_gap(&self, u: u32, w: u32, from: u32, seg: (Point3, Point3)) -> bool {
+        if !(self.mesh.is_boundary_vertex(u) && self.mesh.is_boundary_vertex(w)) {
+            return false;
+        }
+        if !off_surface::is_off_surface(self.mesh, u, w) {
+            return false;
+        }
+        match route::find(self.mesh, from, w, seg, &self.locked, ROUTE_BUDGET) {
+            Err(_) => true,
+            Ok(crossings) => {
+                let pos = &self.mesh.pos;
+                let mut at = pos[from as usize];
+                let mut len = 0.0;
+                for c in &crossings {
+                    let (pl, pr) = (pos[c.l as usize], pos[c.r as usize]);
+                    let x =
+                        crate::geometry::add(pl, crate::geometry::scale(crate::geometry::sub(pr, pl), c.lam));
+                    len += crate::geometry::dist(at, x);
+                    at = x;
+                }
+                len += crate::geometry::dist(at, pos[w as usize]);
+                len > super::LONG_DETOUR * crate::geometry::dist(pos[from as usize], pos[w as usize])
             }
         }
     }

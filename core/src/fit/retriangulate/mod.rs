@@ -17,11 +17,13 @@
 //!   [`dijkstra`]) if that turns no face over, else the route across faces split into a chain
 //!   ([`route`]), which exists whenever the realised curves do not separate the ends. A segment
 //!   with no route is reported as "separated" (crossing or tangled input), never dropped silently.
+//! - A segment whose straight way crosses a hole of the template (or runs past its rim) is not
+//!   routed around the hole: it is counted as `off_surface_segments` ([`off_surface`]).
 //!
 //! Files: this one (the order of segments: walks first, fallbacks after), `walk.rs` (the walk
 //! along the cutting plane of `cut.rs` and the snapping), `fill.rs` (the ear-cut re-filling of a
 //! walked strip), `split.rs` (edge splits along a segment), `fallback.rs` with `dijkstra.rs` and
-//! `route.rs`, `snap.rs` (moves onto a segment that turn no face over), `stats.rs` (the report).
+//! `route.rs`, `off_surface.rs` (segments over a hole), `snap.rs` (moves onto a segment that turn no face over), `stats.rs` (the report).
 
 use crate::error::Result;
 use crate::job::Progress;
@@ -33,6 +35,7 @@ mod cut;
 mod dijkstra;
 mod fallback;
 mod fill;
+mod off_surface;
 mod route;
 mod snap;
 mod split;

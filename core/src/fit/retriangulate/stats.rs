@@ -46,6 +46,11 @@ pub struct RetriStats {
     /// components, or the two sides of an unwelded seam): no chain of edges can exist, whatever
     /// the re-triangulation does. Weld or repair the template to realise them.
     pub failed_pieces: usize,
+    /// Of those, segments with no surface under them: the straight way between their ends crosses
+    /// a hole of the template or runs past its outer rim (a scan with a gap under a curve), so no
+    /// chain of edges can follow them and a route around the gap would cut a spurious region off
+    /// ([`super::off_surface`]). Close the template's holes (the repair job) to realise them.
+    pub off_surface_segments: usize,
     /// Why walks stopped (one count per failed walk piece).
     pub walk_fail_start: usize,
     pub walk_fail_boundary: usize,
@@ -67,7 +72,8 @@ pub struct FailedSegment {
     pub stopped_at: u32,
     /// "start", "boundary", "curve_edge", "lost" or "fill".
     pub walk: &'static str,
-    /// Why the route fallback found no way: "pieces" (the ends are on pieces of the template that
+    /// Why the route fallback found no way: "off_surface" (the segment crosses a hole of the
+    /// template or runs past its rim: no fallback is tried), "pieces" (the ends are on pieces of the template that
     /// no edge joins: different components or the two sides of an unwelded seam), "separated"
     /// (curve edges realised earlier separate the ends on the surface: crossing or tangled input,
     /// no chain exists without crossing a curve) or "budget" (search limit reached).
