@@ -326,33 +326,17 @@ fn spread_sample(net: &CurveNetwork, h: f64, excluded: &[bool]) -> Vec<u32> {
     out
 }
 
-/// Drops centres that coincide (within 1e-9 of the extent) with an earlier one: two samples can
-/// share a foot where the surface is concave.
+/// Drops centres that coincide (within 1e-7 of the extent) with an earlier kept one: two
+/// samples can share a foot where the surface is concave. A pile of three or more keeps one (the
+/// old rule, each centre against its nearest other only, kept two of a pile of three, the level's
+/// RBF was then refused as singular and the whole level skipped: icosphere onto homer's sections).
 fn dedup_centres(centres: &mut Vec<Point3>, values: &mut Vec<Point3>) {
-    let Some(bb) = crate::geometry::Aabb::of(centres) else { return };
-    let tol = 1e-7 * bb.diagonal().max(f64::MIN_POSITIVE);
-    let tree = super::kdtree::KdTree::new(centres);
-    let mut keep = vec![true; centres.len()];
-    for i in 0..centres.len() {
-        if !keep[i] {
-            continue;
-        }
-        if let Some((j, d2)) = tree.nearest_filtered(centres[i], |j| j as usize != i && keep[j as usize]) {
-            if d2.sqrt() <= tol && (j as usize) > i {
-                keep[j as usize] = false;
-            }
-        }
+    let kept = super::insert::coincident::first_of_each_place(centres, 1e-7);
+    if kept.len() == centres.len() {
+        return;
     }
-    let mut k = 0;
-    centres.retain(|_| {
-        k += 1;
-        keep[k - 1]
-    });
-    let mut k = 0;
-    values.retain(|_| {
-        k += 1;
-        keep[k - 1]
-    });
+    *centres = kept.iter().map(|&i| centres[i]).collect();
+    *values = kept.iter().map(|&i| values[i]).collect();
 }
 
 #[cfg(test)]

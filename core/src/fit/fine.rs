@@ -9,6 +9,7 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::coarse::{fit_rbf, CoarseReport};
+use super::insert::coincident;
 use super::{approach, correspond, curves, flips, insert, FitParams, Matching};
 
 /// The fine stage's result.
@@ -32,6 +33,9 @@ pub struct FineReport {
     pub faces_added: usize,
     /// Faces still flipped by the last round (goal 0).
     pub flipped_faces: usize,
+    /// Curve points whose inserted template vertex coincided with another's (within the RBF's
+    /// duplicate tolerance), left out of the fine RBF (matching = insert; goal 0).
+    pub coincident_centres: usize,
     /// The fine centres were coplanar and `coplanar_centres = "augment"` handled them (RBF with
     /// the in-plane polynomial, [`super::rbf::Rbf::fit_in_plane`]).
     pub augmented: bool,
@@ -161,9 +165,17 @@ fn fine_fit_inserted(
     let vop = ins.vertex_of_point.clone();
     let distances: Vec<f64> = (0..vop.len()).map(|p| dist(net.points[p], pos[vop[p] as usize])).collect();
     check_distances(&distances, net, params, template_diag)?;
-    let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
-    let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();
-    let name = |i: usize| format!("curve {} point {i} (template vertex {})", net.curve_of_point[i], vop[i]);
+    let all_centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
+    // Template vertices the insertion made at one place (a last resort: piled feet are spread,
+    // see [`insert::pileup`]) are one centre; the others still land exactly on their points below.
+    let kept = coincident::first_of_each_place(&all_centres, coincident::SAME_PLACE);
+    let coincident_centres = vop.len() - kept.len();
+    let centres: Vec<Point3> = kept.iter().map(|&p| all_centres[p]).collect();
+    let values: Vec<Point3> = kept.iter().map(|&p| sub(net.points[p], all_centres[p])).collect();
+    let name = |i: usize| {
+        let p = kept[i];
+        format!("curve {} point {p} (template vertex {})", net.curve_of_point[p], vop[p])
+    };
     lap(0);
     let f = fit_rbf(centres, values, params, "fine", "curves", &name, progress)?;
     lap(1);
@@ -216,6 +228,7 @@ fn fine_fit_inserted(
             flagged_by_orientation: scan.by_orientation,
             faces_added,
             flipped_faces: scan.flipped.len(),
+            coincident_centres,
             augmented,
             matching: "insert",
             insertion: Some(ins.stats),
@@ -293,6 +306,7 @@ fn fine_fit(
                 flagged_by_orientation: scan.by_orientation,
                 faces_added,
                 flipped_faces: scan.flipped.len(),
+                coincident_centres: 0,
                 augmented,
                 matching: "nearest_vertex",
                 insertion: None,

@@ -30,7 +30,9 @@ use super::curves::CurveNetwork;
 use super::kdtree::KdTree;
 use super::trimesh::TriMesh;
 
+pub mod coincident;
 pub mod order;
+pub mod pileup;
 pub mod walk;
 
 /// A foot whose largest barycentric coordinate is above 1 − this reuses that vertex.
@@ -53,6 +55,9 @@ pub struct InsertStats {
     /// Curve points whose foot was searched along their curve ([`walk`]) and differs from their
     /// closest point (which was on a part of the template the curve does not pass).
     pub walked_feet: usize,
+    /// Curve points whose foot was shared with another's (piled at a convex corner or crease)
+    /// and was spread over the faces there ([`pileup`]).
+    pub spread_feet: usize,
     /// Segments whose feet step out of the curve's order ([`order`]) with plain closest points,
     /// and with the walked feet used.
     pub out_of_order_closest: usize,
@@ -108,6 +113,15 @@ pub fn insert_curve_points(
     let foot_points = |feet: &[(u32, Point3, f64)]| feet.iter().map(|f| f.1).collect::<Vec<_>>();
     let out_of_order_closest = order::out_of_order_segments(net, &foot_points(&feet));
     let walked = walk::walk_feet(pos, tris, &vf, net, &mut feet, &anchor, progress)?;
+    // Feet piled at one point (beyond a convex corner) would become coincident RBF centres.
+    let mut keep = vec![false; n];
+    for &(p, _) in fixed {
+        keep[p as usize] = true;
+    }
+    for b in &on_rim {
+        keep[b.point_index as usize] = true;
+    }
+    let spread = pileup::spread_piled_feet(pos, tris, &vf, &net.points, &mut feet, &keep);
     let out_of_order = order::out_of_order_segments(net, &foot_points(&feet));
     let spacing = shortest_segments(net);
     let mut queue: Vec<u32> = (0..n as u32).filter(|&p| vop[p as usize] == u32::MAX).collect();
@@ -124,6 +138,7 @@ pub fn insert_curve_points(
         vop[p as usize] = ins.at_foot(p, feet[p as usize], 0.25 * spacing[p as usize])?;
     }
     ins.stats.walked_feet = walked;
+    ins.stats.spread_feet = spread;
     ins.stats.out_of_order_closest = out_of_order_closest;
     ins.stats.out_of_order = out_of_order;
     let d: Vec<f64> = (0..n).map(|p| dist(net.points[p], ins.mesh.pos[vop[p] as usize])).collect();
