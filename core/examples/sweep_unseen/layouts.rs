@@ -5,13 +5,15 @@
 
 use std::f64::consts::PI;
 
-use meshwork_core::fit::testdata::{circle, disjoint_union, ellipsoid_sections, polylines, with_holes};
+use meshwork_core::fit::testdata::{disjoint_union, ellipsoid_sections, polylines, with_holes};
 use meshwork_core::geometry::norm;
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
+use meshwork_core::Error;
 
 use crate::support::{
-    case, lines_of, repaired, sections_of, sphere_sections, to_unit_box, Case, Expect, O, X, Y, Z,
+    case, equator_and_meridians, fit_inputs, lines_of, repaired_vs_own_sections, shifted, sphere_sections,
+    vs_octants, Case, Expect, X,
 };
 
 /// A cube sphere of radius `r`: 6 faces of n×n quads, welded, projected on the sphere.
@@ -73,18 +75,13 @@ fn uv_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
     Mesh::from_triangles(pos, &tris)
 }
 
-fn shifted(m: &Mesh, by: Point3) -> Mesh {
-    let mut m = m.clone();
-    for p in &mut m.positions {
-        *p = [p[0] + by[0], p[1] + by[1], p[2] + by[2]];
-    }
-    m
-}
-
-fn merged_curves(a: &Mesh, b: &Mesh) -> Mesh {
-    let mut l = lines_of(a);
-    l.extend(lines_of(b));
-    polylines(&l)
+/// Two unit icospheres `dx` apart along x, each with its own copy of `curves`.
+fn two_spheres(dx: f64, curves: &Mesh) -> Result<Vec<Mesh>, Error> {
+    let by = [dx, 0.0, 0.0];
+    let t = disjoint_union(&icosphere(3, 1.0), &shifted(&icosphere(3, 1.0), by));
+    let mut l = lines_of(curves);
+    l.extend(lines_of(&shifted(curves, by)));
+    fit_inputs(t, polylines(&l))
 }
 
 pub fn layouts() -> Vec<Case> {
@@ -93,59 +90,49 @@ pub fn layouts() -> Vec<Case> {
 
     out.push(case(
         "hole where two curves cross (auto)",
-        || Ok(vec![with_holes(&icosphere(3, 1.0), &[X], 0.2), sphere_sections(6)]),
+        || vs_octants(with_holes(&icosphere(3, 1.0), &[X], 0.2)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
 
     out.push(case(
         "hole where two curves cross (none)",
-        || Ok(vec![with_holes(&icosphere(3, 1.0), &[X], 0.2), sphere_sections(6)]),
+        || vs_octants(with_holes(&icosphere(3, 1.0), &[X], 0.2)),
         json!({"alignment": "none"}),
         Expect::Fit(Some(8)),
     ));
 
     out.push(case(
         "big hole under a curve (none)",
-        || Ok(vec![with_holes(&icosphere(3, 1.0), &[[0.0, 0.7071, 0.7071]], 0.35), sphere_sections(6)]),
+        || vs_octants(with_holes(&icosphere(3, 1.0), &[[0.0, 0.7071, 0.7071]], 0.35)),
         json!({"alignment": "none"}),
         Expect::Fit(Some(8)),
     ));
 
     out.push(case(
         "two components, curves on both (none)",
-        || {
-            let t = disjoint_union(&icosphere(3, 1.0), &shifted(&icosphere(3, 1.0), [5.0, 0.0, 0.0]));
-            Ok(vec![t, merged_curves(&sphere_sections(6), &shifted(&sphere_sections(6), [5.0, 0.0, 0.0]))])
-        },
+        || two_spheres(5.0, &sphere_sections(6)),
         json!({"alignment": "none"}),
         Expect::Fit(Some(16)),
     ));
 
     out.push(case(
         "two components, curves on both (auto)",
-        || {
-            let t = disjoint_union(&icosphere(3, 1.0), &shifted(&icosphere(3, 1.0), [5.0, 0.0, 0.0]));
-            Ok(vec![t, merged_curves(&sphere_sections(6), &shifted(&sphere_sections(6), [5.0, 0.0, 0.0]))])
-        },
+        || two_spheres(5.0, &sphere_sections(6)),
         json!({}),
         Expect::Fit(Some(16)),
     ));
 
     out.push(case(
         "two components, curves on both, touching nets",
-        || {
-            let t = disjoint_union(&icosphere(3, 1.0), &shifted(&icosphere(3, 1.0), [2.2, 0.0, 0.0]));
-            let a = ellipsoid_sections([1.05, 1.0, 1.0], 6);
-            Ok(vec![t, merged_curves(&a, &shifted(&a, [2.2, 0.0, 0.0]))])
-        },
+        || two_spheres(2.2, &ellipsoid_sections([1.05, 1.0, 1.0], 6)),
         json!({"alignment": "none"}),
         Expect::Fit(Some(16)),
     ));
 
     out.push(case(
         "cube sphere (quads only)",
-        || Ok(vec![cube_sphere(8, 1.0), sphere_sections(6)]),
+        || vs_octants(cube_sphere(8, 1.0)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -183,7 +170,7 @@ pub fn layouts() -> Vec<Case> {
                     }
                 }
             }
-            Ok(vec![cube_sphere(8, 1.0), polylines(&l)])
+            fit_inputs(cube_sphere(8, 1.0), polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(6)),
@@ -191,22 +178,7 @@ pub fn layouts() -> Vec<Case> {
 
     out.push(case(
         "UV sphere (pole valence 32), 4 meridians + equator",
-        || {
-            let mut l = vec![circle(O, X, Y, 1.0, 48, 0.1)];
-            for k in 0..4 {
-                let t = 0.3 + PI / 2.0 * k as f64;
-                l.push(meshwork_core::fit::testdata::arc(
-                    O,
-                    [t.cos(), t.sin(), 0.0],
-                    Z,
-                    1.0,
-                    -PI / 2.0,
-                    PI / 2.0,
-                    24,
-                ));
-            }
-            Ok(vec![uv_sphere(32, 16, 1.0), polylines(&l)])
-        },
+        || fit_inputs(uv_sphere(32, 16, 1.0), polylines(&equator_and_meridians(4, 0.3, 0.1))),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -215,12 +187,7 @@ pub fn layouts() -> Vec<Case> {
     for name in ["beetle", "teapot", "suzanne"] {
         out.push(case(
             &format!("{name}-repaired vs own sections"),
-            move || {
-                let (c, raw, _) = sections_of(name);
-                let mut t = repaired(raw);
-                to_unit_box(&mut t);
-                Ok(vec![t, c])
-            },
+            move || repaired_vs_own_sections(name),
             json!({"alignment": "none"}),
             Expect::Fit(None),
         ));

@@ -66,11 +66,34 @@ fn cases() -> Vec<Case> {
     .collect()
 }
 
+/// One line naming what a case feeds and expects, without fitting: its name, expectation,
+/// parameters and a fingerprint of its inputs (`SWEEP_LIST=1`; two listings are equal when the
+/// cases are, which is how a rewrite of the case builders is checked).
+fn listing(c: &Case) -> String {
+    use std::hash::{Hash, Hasher};
+    let inputs = match (c.inputs)() {
+        Ok(meshes) => {
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            format!("{meshes:?}").hash(&mut h);
+            let counts: Vec<_> =
+                meshes.iter().map(|m| (m.positions.len(), m.faces.len(), m.curves.len())).collect();
+            format!("{:016x} {counts:?}", h.finish())
+        }
+        Err(e) => format!("error {e}"),
+    };
+    format!("{} | {:?} | {} | {inputs}", c.name, c.expect, c.params)
+}
+
 fn main() {
     faer::set_global_parallelism(faer::Par::Seq);
     let only: Vec<String> = std::env::args().skip(1).collect();
+    let list = std::env::var("SWEEP_LIST").is_ok();
     for c in cases() {
         if !only.is_empty() && !only.iter().any(|o| c.name.contains(o.as_str())) {
+            continue;
+        }
+        if list {
+            println!("{}", listing(&c));
             continue;
         }
         let t = Instant::now();

@@ -7,9 +7,8 @@ use std::f64::consts::PI;
 use meshwork_core::fit::testdata::{circle, polylines, quarter_arcs_with_gap, tilted_wave};
 use meshwork_core::geometry::norm;
 use meshwork_core::mesh::Point3;
-use meshwork_core::shapes::icosphere;
 
-use crate::support::{bumpy, case, lines_of, sphere_sections, Case, Expect, AXES, O, X, Y, Z};
+use crate::support::{bumpy, case, lines_of, on_icosphere, sphere_sections, Case, Expect, AXES, O, X, Y, Z};
 
 pub fn networks() -> Vec<Case> {
     use serde_json::json;
@@ -20,14 +19,14 @@ pub fn networks() -> Vec<Case> {
         "JSON polylines with gaps 3× join tolerance",
         || {
             let c = quarter_arcs_with_gap(AXES, 3e-6 * 2.0 * (AXES[0].powi(2) + AXES[1].powi(2)).sqrt());
-            Ok(vec![icosphere(3, 1.0), c])
+            on_icosphere(c)
         },
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "gaps 1% of diagonal (ends near ends)",
-        || Ok(vec![icosphere(3, 1.0), quarter_arcs_with_gap(AXES, 0.035)]),
+        || on_icosphere(quarter_arcs_with_gap(AXES, 0.035)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -38,20 +37,20 @@ pub fn networks() -> Vec<Case> {
             let mut lines = vec![circle(O, X, Y, 1.08, 48, 0.0)];
             lines.push(meshwork_core::fit::testdata::arc(O, X, Z, 1.08, 0.0, PI, 24));
             lines.push(meshwork_core::fit::testdata::arc(O, Y, Z, 1.08, 0.0, PI, 24));
-            Ok(vec![icosphere(3, 1.0), polylines(&lines)])
+            on_icosphere(polylines(&lines))
         },
         json!({}),
         Expect::Fit(Some(5)),
     ));
     out.push(case(
         "single closed loop (planar)",
-        || Ok(vec![icosphere(3, 1.0), polylines(&[circle(O, X, Y, 1.0, 48, 0.1)])]),
+        || on_icosphere(polylines(&[circle(O, X, Y, 1.0, 48, 0.1)])),
         none(),
         Expect::Error(&["plane"]),
     ));
     out.push(case(
         "single closed loop (planar, augment)",
-        || Ok(vec![icosphere(3, 1.0), polylines(&[circle(O, X, Y, 1.0, 48, 0.1)])]),
+        || on_icosphere(polylines(&[circle(O, X, Y, 1.0, 48, 0.1)])),
         json!({"alignment": "none", "coplanar_centres": "augment"}),
         Expect::Fit(Some(2)),
     ));
@@ -59,7 +58,7 @@ pub fn networks() -> Vec<Case> {
         "single closed loop, non-planar (tilted wave)",
         || {
             let pts = tilted_wave(60, true);
-            Ok(vec![icosphere(3, 1.0), polylines(&[pts])])
+            on_icosphere(polylines(&[pts]))
         },
         none(),
         Expect::Fit(Some(2)),
@@ -67,13 +66,9 @@ pub fn networks() -> Vec<Case> {
     out.push(case(
         "a fourth curve 10 diagonals away",
         || {
-            let mut lines: Vec<Vec<Point3>> = Vec::new();
-            let c = sphere_sections(6);
-            for l in &c.curves {
-                lines.push(l.iter().map(|&v| c.positions[v as usize]).collect());
-            }
+            let mut lines = lines_of(&sphere_sections(6));
             lines.push(circle([30.0, 0.0, 0.0], X, Y, 0.5, 12, 0.0));
-            Ok(vec![icosphere(3, 1.0), polylines(&lines)])
+            on_icosphere(polylines(&lines))
         },
         json!({}),
         Expect::Error(&["curve 3"]),
@@ -83,7 +78,7 @@ pub fn networks() -> Vec<Case> {
         move || {
             let mut l = gc(48, [0.0; 3]);
             l.push(circle(O, X, Y, 1.0, 37, 0.03));
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -94,7 +89,7 @@ pub fn networks() -> Vec<Case> {
             let mut l = lines_of(&sphere_sections(6));
             let rev: Vec<Vec<Point3>> = l.iter().map(|x| x.iter().rev().copied().collect()).collect();
             l.extend(rev);
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -105,7 +100,7 @@ pub fn networks() -> Vec<Case> {
             let mut l = lines_of(&sphere_sections(6));
             let back: Vec<Point3> = l[0].iter().rev().take(l[0].len() / 2).copied().collect();
             l[0].extend(back.into_iter().skip(1));
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -115,7 +110,7 @@ pub fn networks() -> Vec<Case> {
         move || {
             let l: Vec<Vec<Point3>> =
                 gc(40, [0.0; 3]).into_iter().map(|c| c.into_iter().map(bumpy).collect()).collect();
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -138,7 +133,7 @@ pub fn networks() -> Vec<Case> {
                         .collect()
                 })
                 .collect();
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -152,7 +147,7 @@ pub fn networks() -> Vec<Case> {
             let first = l[0][0];
             l[0].drain(1..q);
             assert!(meshwork_core::geometry::dist(first, l[0][0]) == 0.0);
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
+            on_icosphere(polylines(&l))
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -169,7 +164,7 @@ pub fn networks() -> Vec<Case> {
                     [d[0] / r, d[1] / r, d[2] / r]
                 })
                 .collect();
-            Ok(vec![icosphere(3, 1.0), polylines(&[l])])
+            on_icosphere(polylines(&[l]))
         },
         json!({}),
         Expect::Fit(Some(3)),

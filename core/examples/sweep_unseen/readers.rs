@@ -7,7 +7,9 @@ use meshwork_core::io::{write, Format};
 use meshwork_core::mesh::Point3;
 use meshwork_core::shapes::icosphere;
 
-use crate::support::{case, read_as, sphere_sections, Case, Expect, O, X, Y};
+use crate::support::{
+    case, fit_inputs, on_icosphere, read_as, segments, sphere_sections, Case, Expect, O, X, Y,
+};
 
 pub fn readers() -> Vec<Case> {
     use serde_json::json;
@@ -16,14 +18,8 @@ pub fn readers() -> Vec<Case> {
         "glTF LINES (segment pairs)",
         || {
             let c = sphere_sections(6);
-            let mut idx = Vec::new();
-            for l in &c.curves {
-                for w in l.windows(2) {
-                    idx.extend_from_slice(w);
-                }
-            }
-            let curves = read_as(&gltf_lines(&c.positions, &idx, 1), "c.gltf")?;
-            Ok(vec![icosphere(3, 1.0), curves])
+            let idx: Vec<u32> = segments(&c).concat();
+            on_icosphere(read_as(&gltf_lines(&c.positions, &idx, 1), "c.gltf")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -32,12 +28,7 @@ pub fn readers() -> Vec<Case> {
         "glTF LINES shuffled segments",
         || {
             let c = sphere_sections(6);
-            let mut segs: Vec<[u32; 2]> = Vec::new();
-            for l in &c.curves {
-                for w in l.windows(2) {
-                    segs.push([w[0], w[1]]);
-                }
-            }
+            let segs = segments(&c);
             // Reverse every other segment and interleave: no two consecutive ones share an end.
             let mut idx = Vec::new();
             let n = segs.len();
@@ -49,8 +40,7 @@ pub fn readers() -> Vec<Case> {
                     idx.extend_from_slice(&s);
                 }
             }
-            let curves = read_as(&gltf_lines(&c.positions, &idx, 1), "c.gltf")?;
-            Ok(vec![icosphere(3, 1.0), curves])
+            on_icosphere(read_as(&gltf_lines(&c.positions, &idx, 1), "c.gltf")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -64,15 +54,14 @@ pub fn readers() -> Vec<Case> {
             let lines = [circle(O, X, Y, 1.2, 40, 0.0)];
             let pts: Vec<Point3> = lines[0][..40].to_vec();
             let idx: Vec<u32> = (0..40).collect();
-            let curves = read_as(&gltf_lines(&pts, &idx, 2), "c.gltf")?;
-            Ok(vec![icosphere(3, 1.0), curves])
+            on_icosphere(read_as(&gltf_lines(&pts, &idx, 2), "c.gltf")?)
         },
         json!({"coplanar_centres": "augment"}),
         Expect::Fit(Some(2)),
     ));
     out.push(case(
         "OBJ l with negative indices",
-        || Ok(vec![icosphere(3, 1.0), read_as(&obj_negative_indices(&sphere_sections(6)), "c.obj")?]),
+        || on_icosphere(read_as(&obj_negative_indices(&sphere_sections(6)), "c.obj")?),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -80,7 +69,7 @@ pub fn readers() -> Vec<Case> {
         "glTF LINE_STRIP from our writer (GLB)",
         || {
             let bytes = write(&sphere_sections(6), Format::Glb)?;
-            Ok(vec![icosphere(3, 1.0), read_as(&bytes, "c.glb")?])
+            on_icosphere(read_as(&bytes, "c.glb")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -93,7 +82,7 @@ pub fn readers() -> Vec<Case> {
                 "ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
                 c.positions.len()
             );
-            let segs: Vec<[u32; 2]> = c.curves.iter().flat_map(|l| l.windows(2).map(|w| [w[0], w[1]])).collect();
+            let segs = segments(&c);
             s += &format!("element edge {}\nproperty int vertex1\nproperty int vertex2\nend_header\n", segs.len());
             for p in &c.positions {
                 s += &format!("{} {} {}\n", p[0], p[1], p[2]);
@@ -101,20 +90,20 @@ pub fn readers() -> Vec<Case> {
             for e in &segs {
                 s += &format!("{} {}\n", e[0], e[1]);
             }
-            Ok(vec![icosphere(3, 1.0), read_as(s.as_bytes(), "c.ply")?])
+            on_icosphere(read_as(s.as_bytes(), "c.ply")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "OBJ curve vertex NaN",
-        || Ok(vec![icosphere(2, 1.0), read_as(b"v 0 0 1\nv nan 0 0\nv 0 1 0\nl 1 2 3\n", "c.obj")?]),
+        || fit_inputs(icosphere(2, 1.0), read_as(b"v 0 0 1\nv nan 0 0\nv 0 1 0\nl 1 2 3\n", "c.obj")?),
         json!({}),
         Expect::Error(&["line 2"]),
     ));
     out.push(case(
         "OBJ curve vertex inf",
-        || Ok(vec![icosphere(2, 1.0), read_as(b"v 0 0 1\nv 1 0 0\nv 0 inf 0\nl 1 2 3\n", "c.obj")?]),
+        || fit_inputs(icosphere(2, 1.0), read_as(b"v 0 0 1\nv 1 0 0\nv 0 inf 0\nl 1 2 3\n", "c.obj")?),
         json!({}),
         Expect::Error(&["line 3"]),
     ));
@@ -125,7 +114,7 @@ pub fn readers() -> Vec<Case> {
                 br#"{"polylines": [[[0,0,1],[1,0,0]], [[0,1,0],[1e999,0,0]]]}"#,
             )
             .expect("json")?;
-            Ok(vec![icosphere(2, 1.0), m])
+            fit_inputs(icosphere(2, 1.0), m)
         },
         json!({}),
         Expect::Error(&["line 1 column 49"]),
@@ -135,38 +124,38 @@ pub fn readers() -> Vec<Case> {
         || {
             let mut t = String::from_utf8(write(&icosphere(1, 1.0), Format::Obj)?).unwrap_or_default();
             t = t.replacen("v ", "v NaN 0 0 #", 1);
-            Ok(vec![read_as(t.as_bytes(), "t.obj")?, sphere_sections(4)])
+            fit_inputs(read_as(t.as_bytes(), "t.obj")?, sphere_sections(4))
         },
         json!({}),
         Expect::Error(&["line"]),
     ));
     out.push(case(
         "empty curves file",
-        || Ok(vec![icosphere(2, 1.0), read_as(b"", "c.obj")?]),
+        || fit_inputs(icosphere(2, 1.0), read_as(b"", "c.obj")?),
         json!({}),
         Expect::Error(&["empty"]),
     ));
     out.push(case(
         "curves file with vertices only",
-        || Ok(vec![icosphere(2, 1.0), read_as(b"v 0 0 0\nv 1 0 0\n", "c.obj")?]),
+        || fit_inputs(icosphere(2, 1.0), read_as(b"v 0 0 0\nv 1 0 0\n", "c.obj")?),
         json!({}),
         Expect::Error(&["polylines"]),
     ));
     out.push(case(
         "empty template file",
-        || Ok(vec![read_as(b"", "t.obj")?, sphere_sections(4)]),
+        || fit_inputs(read_as(b"", "t.obj")?, sphere_sections(4)),
         json!({}),
         Expect::Error(&["empty"]),
     ));
     out.push(case(
         "template with only points (no faces)",
-        || Ok(vec![read_as(b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "t.obj")?, sphere_sections(4)]),
+        || fit_inputs(read_as(b"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "t.obj")?, sphere_sections(4)),
         json!({}),
         Expect::Error(&["faces"]),
     ));
     out.push(case(
         "curves file is a triangle mesh (no lines)",
-        || Ok(vec![icosphere(2, 1.0), icosphere(2, 1.2)]),
+        || fit_inputs(icosphere(2, 1.0), icosphere(2, 1.2)),
         json!({}),
         Expect::Error(&["polylines"]),
     ));

@@ -2,14 +2,14 @@
 //! dense curves, a dense one with sparse curves, an icosphere aligned automatically onto spot or
 //! fandisk, thin flattened ellipsoids, and spot far from the origin or at extreme scales.
 
-use meshwork_core::fit::testdata::{bend, ellipsoid_sections, plane_sections, section_regions, to_unit_box};
+use meshwork_core::fit::testdata::{bend, ellipsoid_sections, plane_sections, section_regions};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
 use meshwork_core::Error;
 
 use crate::support::{
-    case, flat_ellipsoid, flatten, read_as, repaired, sections_of, shared, sphere_sections, Case, Expect,
-    AXES,
+    case, fit_inputs, flat_ellipsoid, flatten, icosphere_vs_sections_of, sections_of, sphere_sections,
+    unit_repaired, Case, Expect, AXES,
 };
 
 pub fn shapes() -> Vec<Case> {
@@ -18,13 +18,13 @@ pub fn shapes() -> Vec<Case> {
     let mut out = Vec::new();
     out.push(case(
         "coarse 80 faces, 5040 curve vertices",
-        || Ok(vec![icosphere(1, 1.0), sphere_sections(420)]),
+        || fit_inputs(icosphere(1, 1.0), sphere_sections(420)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "coarse 320 faces, 2400 curve vertices",
-        || Ok(vec![icosphere(2, 1.0), sphere_sections(200)]),
+        || fit_inputs(icosphere(2, 1.0), sphere_sections(200)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -62,7 +62,7 @@ pub fn shapes() -> Vec<Case> {
                         *p = bend(*p, 1.0);
                     }
                 }
-                Ok(vec![t, c])
+                fit_inputs(t, c)
             },
             json!({}),
             // The round template cannot follow a thin target: without the face guard it ran for
@@ -92,33 +92,21 @@ pub fn shapes() -> Vec<Case> {
     ));
     out.push(case(
         "dense template (20k faces), 4-point octants",
-        || Ok(vec![icosphere(5, 1.0), ellipsoid_sections(AXES, 1)]),
+        || fit_inputs(icosphere(5, 1.0), ellipsoid_sections(AXES, 1)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out
 }
 
-/// An icosphere of radius 0.5 in the unit box (the sweep's frame) and the sections of shared
-/// mesh `name`: a template of another shape, aligned automatically.
-fn icosphere_vs_sections_of(name: &str) -> Result<Vec<Mesh>, Error> {
-    let (c, _, _) = sections_of(name);
-    let mut t = icosphere(3, 0.5);
-    for p in &mut t.positions {
-        *p = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5];
-    }
-    Ok(vec![t, c])
-}
-
 /// Spot (repaired, unit box) and its own sections, both scaled by `s` and moved by `o`.
 fn spot_and_sections_moved(s: f64, o: Point3) -> Result<Vec<Mesh>, Error> {
     let (mut c, _, _) = sections_of("spot");
-    let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-    to_unit_box(&mut t);
+    let mut t = unit_repaired("spot")?;
     for m in [&mut t, &mut c] {
         for p in &mut m.positions {
             *p = [p[0] * s + o[0], p[1] * s + o[1], p[2] * s + o[2]];
         }
     }
-    Ok(vec![t, c])
+    fit_inputs(t, c)
 }

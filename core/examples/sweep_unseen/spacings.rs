@@ -4,26 +4,20 @@
 //! icosphere onto homer's sections, and networks that define no deformation (one straight line,
 //! all points at one place but two).
 
-use std::f64::consts::PI;
-
 use meshwork_core::fit::testdata::{circle, great_circles, polylines};
 use meshwork_core::geometry::{cross, norm};
-use meshwork_core::mesh::{Mesh, Point3};
+use meshwork_core::mesh::Mesh;
 use meshwork_core::shapes::icosphere;
 
 use crate::support::{
-    case, lines_of, read_as, repaired, sections_of, shared, sphere_sections, to_unit_box, Case, Expect, O, X,
-    Y, Z,
+    case, equator_and_meridians, fit_inputs, icosphere_vs_sections_of, lines_of, on_icosphere, read_as,
+    sections_of, segments, sphere_sections, unit_repaired, Case, Expect, X, Y, Z,
 };
 
-fn gc(r: f64, n: usize) -> Vec<Vec<Point3>> {
-    great_circles(r, n, [0.0; 3])
-}
-
-fn shifted(m: &Mesh, by: Point3) -> Mesh {
-    let mut m = m.clone();
+/// `m` with every position multiplied by `s`.
+fn scaled(mut m: Mesh, s: f64) -> Mesh {
     for p in &mut m.positions {
-        *p = [p[0] + by[0], p[1] + by[1], p[2] + by[2]];
+        *p = [p[0] * s, p[1] * s, p[2] * s];
     }
     m
 }
@@ -34,44 +28,14 @@ pub fn spacings() -> Vec<Case> {
 
     out.push(case(
         "star: 6 half-meridians at each pole + equator",
-        || {
-            let mut l = vec![circle(O, X, Y, 1.0, 48, 0.0)];
-            for k in 0..6 {
-                let t = PI / 3.0 * k as f64;
-                l.push(meshwork_core::fit::testdata::arc(
-                    O,
-                    [t.cos(), t.sin(), 0.0],
-                    Z,
-                    1.0,
-                    -PI / 2.0,
-                    PI / 2.0,
-                    24,
-                ));
-            }
-            Ok(vec![icosphere(3, 1.0), polylines(&l)])
-        },
+        || fit_inputs(icosphere(3, 1.0), polylines(&equator_and_meridians(6, 0.0, 0.0))),
         json!({}),
         Expect::Fit(Some(12)),
     ));
 
     out.push(case(
         "star: 12 half-meridians at each pole, coarse template",
-        || {
-            let mut l = vec![circle(O, X, Y, 1.0, 48, 0.0)];
-            for k in 0..12 {
-                let t = PI / 6.0 * k as f64;
-                l.push(meshwork_core::fit::testdata::arc(
-                    O,
-                    [t.cos(), t.sin(), 0.0],
-                    Z,
-                    1.0,
-                    -PI / 2.0,
-                    PI / 2.0,
-                    24,
-                ));
-            }
-            Ok(vec![icosphere(2, 1.0), polylines(&l)])
-        },
+        || fit_inputs(icosphere(2, 1.0), polylines(&equator_and_meridians(12, 0.0, 0.0))),
         json!({}),
         Expect::Fit(Some(24)),
     ));
@@ -83,7 +47,7 @@ pub fn spacings() -> Vec<Case> {
                 &meshwork_core::fit::testdata::gltf_strips_with_nodes(&lines_of(&sphere_sections(6))),
                 "c.gltf",
             )?;
-            Ok(vec![icosphere(3, 1.0), curves])
+            on_icosphere(curves)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -93,8 +57,7 @@ pub fn spacings() -> Vec<Case> {
         "OBJ segment soup (l with 2 points, own vertices, shuffled)",
         || {
             let c = sphere_sections(6);
-            let segs: Vec<[u32; 2]> =
-                c.curves.iter().flat_map(|l| l.windows(2).map(|w| [w[0], w[1]])).collect();
+            let segs = segments(&c);
             let n = segs.len();
             let mut s = String::new();
             for k in 0..n {
@@ -106,7 +69,7 @@ pub fn spacings() -> Vec<Case> {
                 }
                 s += &format!("l {} {}\n", 2 * k + 1, 2 * k + 2);
             }
-            Ok(vec![icosphere(3, 1.0), read_as(s.as_bytes(), "c.obj")?])
+            on_icosphere(read_as(s.as_bytes(), "c.obj")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -131,7 +94,7 @@ pub fn spacings() -> Vec<Case> {
                 }
                 s += "\n";
             }
-            Ok(vec![icosphere(3, 1.0), read_as(s.as_bytes(), "c.obj")?])
+            on_icosphere(read_as(s.as_bytes(), "c.obj")?)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -152,7 +115,7 @@ pub fn spacings() -> Vec<Case> {
             let v = cross(d, u);
             let c = [d[0] * 1.02, d[1] * 1.02, d[2] * 1.02];
             l.push(circle(c, u, v, 0.03, 12, 0.0));
-            Ok(vec![icosphere(2, 1.0), polylines(&l)])
+            fit_inputs(icosphere(2, 1.0), polylines(&l))
         },
         json!({"alignment": "none"}),
         Expect::Fit(Some(9)),
@@ -161,9 +124,9 @@ pub fn spacings() -> Vec<Case> {
     out.push(case(
         "thin band: two parallels 0.01 apart on a coarse template",
         || {
-            let mut l = gc(1.0, 48);
+            let mut l = great_circles(1.0, 48, [0.0; 3]);
             l.push(circle([0.0, 0.0, 0.01], X, Y, (1.0f64 - 1e-4).sqrt(), 48, 0.0));
-            Ok(vec![icosphere(2, 1.0), polylines(&l)])
+            fit_inputs(icosphere(2, 1.0), polylines(&l))
         },
         json!({"alignment": "none"}),
         Expect::Fit(Some(12)),
@@ -171,26 +134,14 @@ pub fn spacings() -> Vec<Case> {
 
     out.push(case(
         "curves 100× the template (auto)",
-        || {
-            let mut c = sphere_sections(6);
-            for p in &mut c.positions {
-                *p = [p[0] * 100.0, p[1] * 100.0, p[2] * 100.0];
-            }
-            Ok(vec![icosphere(3, 1.0), c])
-        },
+        || on_icosphere(scaled(sphere_sections(6), 100.0)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
 
     out.push(case(
         "curves 1/100 of the template (auto)",
-        || {
-            let mut c = sphere_sections(6);
-            for p in &mut c.positions {
-                *p = [p[0] * 0.01, p[1] * 0.01, p[2] * 0.01];
-            }
-            Ok(vec![icosphere(3, 1.0), c])
-        },
+        || on_icosphere(scaled(sphere_sections(6), 0.01)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -201,8 +152,7 @@ pub fn spacings() -> Vec<Case> {
         "spot vs its own sections rotated (auto)",
         || {
             let (c, _, _) = sections_of("spot");
-            let mut t = repaired(read_as(&shared("spot"), "x.obj")?);
-            to_unit_box(&mut t);
+            let t = unit_repaired("spot")?;
             let mut c = c;
             let (a, b) = (0.7f64, 0.4f64);
             for p in &mut c.positions {
@@ -211,7 +161,7 @@ pub fn spacings() -> Vec<Case> {
                 let q = [q[0], b.cos() * q[1] - b.sin() * q[2], b.sin() * q[1] + b.cos() * q[2]];
                 *p = [q[0] + 3.0, q[1] - 1.0, q[2] + 0.5];
             }
-            Ok(vec![t, c])
+            fit_inputs(t, c)
         },
         json!({}),
         Expect::Fit(Some(spot_regions)),
@@ -219,21 +169,17 @@ pub fn spacings() -> Vec<Case> {
 
     out.push(case(
         "icosphere vs sections of homer (auto)",
-        || {
-            let (c, _, _) = sections_of("homer");
-            let t = shifted(&icosphere(3, 0.5), [0.5, 0.5, 0.5]);
-            Ok(vec![t, c])
-        },
+        || icosphere_vs_sections_of("homer"),
         json!({}),
         Expect::Fit(None),
     ));
     out.push(case(
         "all curves collinear (a straight line)",
         || {
-            Ok(vec![
+            fit_inputs(
                 icosphere(2, 1.0),
                 polylines(&[(0..10).map(|k| [k as f64 * 0.2 - 1.0, 0.0, 0.0]).collect()]),
-            ])
+            )
         },
         json!({}),
         Expect::Error(&["curve"]),
@@ -242,10 +188,10 @@ pub fn spacings() -> Vec<Case> {
     out.push(case(
         "every curve point identical but two",
         || {
-            Ok(vec![
+            fit_inputs(
                 icosphere(2, 1.0),
                 polylines(&[vec![[0.0, 0.0, 1.0]; 10], vec![[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]]),
-            ])
+            )
         },
         json!({}),
         Expect::Error(&["curve"]),

@@ -2,11 +2,14 @@
 //! several components or holes), and template defects (inside out, a fin, a stray triangle, a face
 //! repeating a vertex, zero-area faces, an open rim the curves run past).
 
-use meshwork_core::fit::testdata::{disjoint_union, ngon_sphere, polylines, with_holes, with_zero_area_face};
+use meshwork_core::fit::testdata::{ngon_sphere, polylines, with_holes, with_zero_area_face};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
 
-use crate::support::{case, repaired, reversed, sections_of, sphere_sections, to_unit_box, Case, Expect};
+use crate::support::{
+    case, fit_inputs, icosphere_and_far, raw_vs_own_sections, repaired_vs_own_sections, reversed,
+    sections_of, vs_octants, Case, Expect,
+};
 
 pub fn templates() -> Vec<Case> {
     use serde_json::json;
@@ -16,10 +19,7 @@ pub fn templates() -> Vec<Case> {
     let spot_regions = sections_of("spot").2;
     out.push(case(
         "suzanne-raw (quads, 4 comps, non-manifold spot)",
-        || {
-            let (c, raw, _) = sections_of("suzanne");
-            Ok(vec![raw, c])
-        },
+        || raw_vs_own_sections("suzanne"),
         none(),
         // Its non-manifold spot is a vertex (every directed edge is used once), which the fit
         // accepts: it must then fit like the repaired copy.
@@ -27,45 +27,31 @@ pub fn templates() -> Vec<Case> {
     ));
     out.push(case(
         "suzanne-repaired (quads+tris)",
-        || {
-            let (c, raw, _) = sections_of("suzanne");
-            let mut t = repaired(raw);
-            to_unit_box(&mut t);
-            Ok(vec![t, c])
-        },
+        || repaired_vs_own_sections("suzanne"),
         none(),
         Expect::Fit(None),
     ));
     out.push(case(
         "teapot-raw (unwelded soup, 4 comps)",
-        || {
-            let (c, raw, _) = sections_of("teapot");
-            Ok(vec![raw, c])
-        },
+        || raw_vs_own_sections("teapot"),
         none(),
         Expect::Fit(None),
     ));
     out.push(case(
         "spot-raw (13 seam pieces) vs own sections",
-        || {
-            let (c, raw, _) = sections_of("spot");
-            Ok(vec![raw, c])
-        },
+        || raw_vs_own_sections("spot"),
         none(),
         Expect::Fit(Some(spot_regions)),
     ));
     out.push(case(
         "beetle-raw (33 pieces, open)",
-        || {
-            let (c, raw, _) = sections_of("beetle");
-            Ok(vec![raw, c])
-        },
+        || raw_vs_own_sections("beetle"),
         none(),
         Expect::Error(&["template edge", "repair"]),
     ));
     out.push(case(
         "ngon-sphere (24-gon caps + quads)",
-        || Ok(vec![ngon_sphere(24, 12, 1.0), sphere_sections(6)]),
+        || vs_octants(ngon_sphere(24, 12, 1.0)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -78,37 +64,25 @@ pub fn templates() -> Vec<Case> {
     let c2 = corners.clone();
     out.push(case(
         "icosphere with 8 holes (one per octant)",
-        move || Ok(vec![with_holes(&icosphere(3, 1.0), &c2, 0.2), sphere_sections(6)]),
+        move || vs_octants(with_holes(&icosphere(3, 1.0), &c2, 0.2)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "two components, curves on one",
-        || {
-            let mut far = icosphere(2, 1.0);
-            for p in &mut far.positions {
-                p[0] += 6.0;
-            }
-            Ok(vec![disjoint_union(&icosphere(3, 1.0), &far), sphere_sections(6)])
-        },
+        || vs_octants(icosphere_and_far(&icosphere(2, 1.0))),
         none(),
         Expect::Fit(Some(9)),
     ));
     out.push(case(
         "two components, auto alignment",
-        || {
-            let mut far = icosphere(2, 1.0);
-            for p in &mut far.positions {
-                p[0] += 6.0;
-            }
-            Ok(vec![disjoint_union(&icosphere(3, 1.0), &far), sphere_sections(6)])
-        },
+        || vs_octants(icosphere_and_far(&icosphere(2, 1.0))),
         json!({}),
         Expect::Fit(Some(9)),
     ));
     out.push(case(
         "zero-area face + unreferenced duplicate vertex",
-        || Ok(vec![with_zero_area_face(3), sphere_sections(6)]),
+        || vs_octants(with_zero_area_face(3)),
         json!({}),
         Expect::Fit(Some(8)),
     ));
@@ -122,7 +96,7 @@ pub fn templates() -> Vec<Case> {
                 .into_iter()
                 .filter(|t| t.iter().all(|&v| ico.positions[v as usize][2] > -0.3))
                 .collect();
-            Ok(vec![Mesh::from_triangles(ico.positions.clone(), &tris), sphere_sections(6)])
+            vs_octants(Mesh::from_triangles(ico.positions.clone(), &tris))
         },
         json!({}),
         // The lower halves of the meridians are 1.1 below the rim: named, not stretched to.
@@ -130,25 +104,19 @@ pub fn templates() -> Vec<Case> {
     ));
     out.push(case(
         "inside-out template",
-        || Ok(vec![reversed(&icosphere(3, 1.0)), sphere_sections(6)]),
+        || vs_octants(reversed(&icosphere(3, 1.0))),
         json!({}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "inside-out template, no alignment",
-        || Ok(vec![reversed(&icosphere(3, 1.0)), sphere_sections(6)]),
+        || vs_octants(reversed(&icosphere(3, 1.0))),
         json!({"alignment": "none"}),
         Expect::Fit(Some(8)),
     ));
     out.push(case(
         "second component inside out",
-        || {
-            let mut far = reversed(&icosphere(2, 1.0));
-            for p in &mut far.positions {
-                p[0] += 6.0;
-            }
-            Ok(vec![disjoint_union(&icosphere(3, 1.0), &far), sphere_sections(6)])
-        },
+        || vs_octants(icosphere_and_far(&reversed(&icosphere(2, 1.0)))),
         json!({"alignment": "none"}),
         Expect::Fit(Some(9)),
     ));
@@ -159,7 +127,7 @@ pub fn templates() -> Vec<Case> {
             let n = t.positions.len() as u32;
             t.positions.extend_from_slice(&[[100.0, 0.0, 0.0], [100.01, 0.0, 0.0], [100.0, 0.01, 0.0]]);
             t.faces.push(&[n, n + 1, n + 2], 0);
-            Ok(vec![t, sphere_sections(6)])
+            vs_octants(t)
         },
         json!({}),
         Expect::Fit(Some(9)),
@@ -172,7 +140,7 @@ pub fn templates() -> Vec<Case> {
             t.positions.push([2.0, 2.0, 2.0]);
             let n = t.positions.len() as u32 - 1;
             t.faces.push(&[f[0], f[1], n], 0);
-            Ok(vec![t, sphere_sections(6)])
+            vs_octants(t)
         },
         json!({}),
         Expect::Error(&["template edge", "320"]),
@@ -182,7 +150,7 @@ pub fn templates() -> Vec<Case> {
         || {
             let mut t = icosphere(3, 1.0);
             t.faces.push(&[3, 3, 5], 0);
-            Ok(vec![t, sphere_sections(6)])
+            vs_octants(t)
         },
         json!({}),
         Expect::Fit(Some(8)),
@@ -196,7 +164,7 @@ pub fn templates() -> Vec<Case> {
             for i in [0, 8, 16, 24] {
                 l.push((0..9).map(|j| at(i, j)).collect());
             }
-            Ok(vec![cyl, polylines(&l)])
+            fit_inputs(cyl, polylines(&l))
         },
         json!({"alignment": "none"}),
         Expect::Fit(Some(8)),
@@ -211,7 +179,7 @@ pub fn templates() -> Vec<Case> {
             for i in [3, 11, 19, 27] {
                 l.push((0..9).map(|j| at(i, j)).collect());
             }
-            Ok(vec![cyl, polylines(&l)])
+            fit_inputs(cyl, polylines(&l))
         },
         json!({"alignment": "none"}),
         Expect::Fit(Some(4)),
@@ -219,10 +187,7 @@ pub fn templates() -> Vec<Case> {
     for name in ["cow", "fandisk", "homer", "rocker-arm"] {
         out.push(case(
             &format!("{name}-raw vs own sections"),
-            move || {
-                let (c, raw, _) = sections_of(name);
-                Ok(vec![raw, c])
-            },
+            move || raw_vs_own_sections(name),
             json!({"alignment": "none"}),
             Expect::Fit(None),
         ));
