@@ -24,11 +24,15 @@
 //! into the family of what it varies (a new file for a new family, listed in `cases()`).
 
 mod check;
+mod densities;
+mod formats;
 mod layouts;
 mod networks;
+mod pair_counts;
 mod pairs;
 mod readers;
 mod shapes;
+mod sources;
 mod spacings;
 mod support;
 mod templates;
@@ -52,6 +56,10 @@ fn cases() -> Vec<Case> {
         pairs::pairs(),
         layouts::layouts(),
         spacings::spacings(),
+        formats::formats(),
+        densities::densities(),
+        pair_counts::pair_counts(),
+        sources::sources(),
     ]
     .into_iter()
     .flatten()

@@ -292,6 +292,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         if !params.cleanup {
             return Ok(cleanup::CleanupStats::default());
         }
+        // The template as given (its own design; a similarity alignment keeps its angles).
+        let template_floor = cleanup::template_floor(&template.positions, &template_tris);
         let mut curve_point = vec![false; mesh.pos.len()];
         for &v in &fine.vertex_of_point {
             curve_point[v as usize] = true;
@@ -301,6 +303,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             locked: curve_edges.clone(),
             chain: cleanup::Constraints::chain_vertices(&realised.chains, &curve_point, &boundary),
             reference_normals: &reference_normals,
+            template_floor: &template_floor,
         };
         let s = cleanup::CleanupSettings { min_angle_deg: params.cleanup_min_angle_deg, max_passes: 8 };
         cleanup::clean(&mut mesh, &mut labels, &mut c, &s, progress)

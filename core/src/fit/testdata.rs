@@ -701,3 +701,34 @@ pub fn tilted_wave(samples: usize, repeat_start: bool) -> Vec<Point3> {
         })
         .collect()
 }
+
+/// A closed UV sphere of radius `r` about the origin: `nu` segments, `nv` rings (every other ring
+/// turned by half a segment), triangle fans at the poles; 2·nu·(nv − 1) faces. With many segments
+/// and few rings every face is a needle (nu = 512, nv = 6: ~0.012 wide, ~0.52 tall): a template
+/// of long thin triangles, like a CAD tessellation.
+pub fn needle_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let mut pos = vec![[0.0, 0.0, -r]];
+    for j in 1..nv {
+        let lat = -FRAC_PI_2 + PI * j as f64 / nv as f64;
+        for i in 0..nu {
+            let t = 2.0 * PI * (i as f64 + 0.5 * (j % 2) as f64) / nu as f64;
+            pos.push([r * lat.cos() * t.cos(), r * lat.cos() * t.sin(), r * lat.sin()]);
+        }
+    }
+    pos.push([0.0, 0.0, r]);
+    let top = (pos.len() - 1) as u32;
+    let id = |i: usize, j: usize| (1 + (j - 1) * nu + i % nu) as u32;
+    let mut tris = Vec::new();
+    for i in 0..nu {
+        tris.push([0, id(i + 1, 1), id(i, 1)]);
+        tris.push([top, id(i, nv - 1), id(i + 1, nv - 1)]);
+    }
+    for j in 1..nv.saturating_sub(1) {
+        for i in 0..nu {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Mesh::from_triangles(pos, &tris)
+}
