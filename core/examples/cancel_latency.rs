@@ -5,7 +5,9 @@
 //!
 //! `CARGO_TARGET_DIR=/work/target-release cargo run --release -p meshwork-core --example cancel_latency [SAMPLES] [FILTER]`
 //! (meshes from `../shared/meshes/`; FILTER keeps the jobs whose name contains it;
-//! `CANCEL_EACH=1` prints every cancel's stage and overshoots on stderr). The inputs
+//! `CANCEL_EACH=1` prints every cancel's stage and overshoots on stderr; `CANCEL_GAPS=1` instead
+//! runs each job once and prints, per stage, the longest CPU stretch between two progress reports,
+//! see [`stage_gaps`]). The inputs
 //! are ~100k-vertex meshes: the bunny split once (139k vertices), homer split twice (96k).
 //!
 //! Two overshoots per cancel: wall time, and the CPU time all threads of this process spent from
@@ -78,6 +80,44 @@ fn timed(kind: JobKind, inputs: &[Mesh], params: &Value, cancel_after: Option<Du
     }
 }
 
+/// Runs the job once with a listener that notes the process CPU time at every progress report
+/// (stage entries and fractions, each of which polls) and returns, per stage in run order, the
+/// reports made in it and the longest CPU stretch from one report to the next (the last one of a
+/// stage runs to the next stage's entry, so work after a stage's last poll counts for it). A
+/// deterministic bound on a cancel's overshoot where a stage polls through `fraction`; stages that
+/// poll with plain `check` between reports show more than their real gap.
+fn stage_gaps(kind: JobKind, inputs: &[Mesh], params: &Value) -> Vec<(String, usize, Duration)> {
+    use std::sync::{Arc, Mutex};
+    let progress = Progress::new();
+    let marks: Arc<Mutex<Vec<(String, Duration)>>> = Arc::default();
+    {
+        let marks = marks.clone();
+        progress.set_listener(move |stage, _| {
+            let cpu = process_cpu();
+            marks.lock().unwrap_or_else(|e| e.into_inner()).push((stage.to_string(), cpu));
+        });
+    }
+    let r = run(kind, inputs.to_vec(), params.clone(), &progress);
+    let end = process_cpu();
+    if let Err(e) = r {
+        eprintln!("  {kind:?}: {e}");
+    }
+    let marks = marks.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    let mut out: Vec<(String, usize, Duration)> = Vec::new();
+    for (i, (stage, t)) in marks.iter().enumerate() {
+        let next = marks.get(i + 1).map_or(end, |m| m.1);
+        let gap = next.saturating_sub(*t);
+        match out.last_mut() {
+            Some(last) if last.0 == *stage => {
+                last.1 += 1;
+                last.2 = last.2.max(gap);
+            }
+            _ => out.push((stage.clone(), 1, gap)),
+        }
+    }
+    out
+}
+
 /// The fit's inputs: homer split twice (96k vertices) and bent plane sections of it.
 fn fit_inputs(homer: &Mesh) -> Vec<Mesh> {
     let planes: Vec<([f64; 3], f64)> = [0.3013, 0.4517, 0.6021, 0.7519, 0.9011]
@@ -145,6 +185,18 @@ fn main() {
         json!({}),
     ));
 
+    if std::env::var("CANCEL_GAPS").is_ok() {
+        println!("| job | stage | progress reports | longest CPU stretch between two (ms) |");
+        println!("|---|---|---|---|");
+        for (name, kind, inputs, params) in jobs.iter().filter(|j| j.0.contains(&filter)) {
+            let mut gaps = stage_gaps(*kind, inputs, params);
+            gaps.sort_by(|a, b| b.2.cmp(&a.2));
+            for (stage, reports, gap) in gaps.iter().take(samples as usize) {
+                println!("| {name} | {stage} | {reports} | {:.1} |", gap.as_secs_f64() * 1e3);
+            }
+        }
+        return;
+    }
     println!("| job | vertices | run (ms) | worst overshoot, wall (ms) | stage | worst overshoot, CPU (ms) | stage | results |");
     println!("|---|---|---|---|---|---|---|---|");
     for (name, kind, inputs, params) in jobs.iter().filter(|j| j.0.contains(&filter)) {

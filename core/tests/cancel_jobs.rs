@@ -180,3 +180,14 @@ fn long_passes_poll_in_proportion_to_their_work() {
     let fair_polls = stage_polls(&s, "fair");
     assert!(fair_polls >= work, "fair polled {fair_polls} times for {work} CG + outer QP iterations");
 }
+
+/// The fit's `partition` (a flood fill over the re-triangulated faces, 200–290 ms of CPU without a
+/// poll on the 200k faces of `cancel_latency`) reports its fraction every 4,096 faces of each of its
+/// two passes: on a 5,120-face template cut into octants at least 2 polls per pass. The code before
+/// made none inside the stage.
+#[test]
+fn the_fit_partition_polls_inside() {
+    let curves = ellipsoid_sections([1.4, 1.15, 0.9], 6);
+    let (_, s) = polls(JobKind::Fit, &[icosphere(4, 1.0), curves], &json!({}));
+    assert!(stage_polls(&s, "partition") >= 2 + 2, "{s:?}");
+}

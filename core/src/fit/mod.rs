@@ -272,8 +272,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     }
     let retri_tris = mesh.live_triangles();
     let angles_retri = report::angle_stats(&mesh.pos, &retri_tris);
-    let (region0, mut region_count) =
-        stages.run(progress, "partition", || Ok(partition::regions(&retri_tris, &curve_edges)))?;
+    let (region0, mut region_count) = stages
+        .run(progress, "partition", || partition::regions_polled(&retri_tris, &curve_edges, progress))?;
     // Label of every face id: region × template group, kept by the clean-up.
     let group0 = if keep_groups {
         groups::after_retriangulation(&fine_tris, &fine_groups, &retri_tris, mesh.pos.len())
@@ -373,7 +373,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             // Flipped edges are never curve edges, so regions are unchanged; the labels are
             // recomputed for the new face list.
             out_tris = mesh.live_triangles();
-            (region, region_count) = partition::regions(&out_tris, &curve_edges);
+            (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
             if keep_groups {
                 tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
             }
@@ -389,7 +389,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         stages.run(progress, "degenerate", || Ok(degenerate::remove_zero_area(&mut mesh, &curve_edges)))?;
     if degenerate.flips > 0 {
         out_tris = mesh.live_triangles();
-        (region, region_count) = partition::regions(&out_tris, &curve_edges);
+        (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
         if keep_groups {
             tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
         }

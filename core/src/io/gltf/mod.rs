@@ -13,7 +13,7 @@
 //! [`crate::Error::ExternalReference`] and never opened.
 
 mod accessor;
-mod base64;
+pub(crate) mod base64;
 pub mod builder;
 mod glb;
 mod json;
