@@ -127,7 +127,6 @@ pub fn with_zero_area_face(levels: u32) -> Mesh {
     Mesh::from_triangles(pos, &out)
 }
 
-
 /// A closed UV sphere of radius `r` about the origin: `nu` segments, `nv` rings (every other ring
 /// turned by half a segment), triangle fans at the poles; 2·nu·(nv − 1) faces. With many segments
 /// and few rings every face is a needle (nu = 512, nv = 6: ~0.012 wide, ~0.52 tall): a template
