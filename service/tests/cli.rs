@@ -3,23 +3,13 @@
 mod common;
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
-use common::{shared_mesh, BIN, TETRA_OBJ};
+use common::{run_cli as run, shared_mesh, stderr_text as stderr, TETRA_OBJ};
 use meshwork_core::io::{read, ReadOptions};
 
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("run meshwork")
-}
-
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("meshwork-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    common::tmp_file("cli", name)
 }
 
 /// No panic message or backtrace ever reaches the user.

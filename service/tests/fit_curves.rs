@@ -5,33 +5,9 @@
 
 mod common;
 
-use common::{file_part, json_part, Server};
+use common::{inline_report, post_fit_on_icosphere, Server};
 use meshwork_core::fit::testdata::{great_circles, polylines};
 use meshwork_core::io::{write, Format};
-use meshwork_core::shapes::icosphere;
-
-fn fit(s: &Server, curves_name: &str, curves: &[u8]) -> common::Resp {
-    let template = write(&icosphere(3, 1.0), Format::Obj).unwrap();
-    s.post_multipart(
-        "/v1/fit?format=obj&report=inline",
-        &[
-            file_part("template", "sphere.obj", &template),
-            file_part("curves", curves_name, curves),
-            json_part("params", "{}"),
-        ],
-    )
-}
-
-fn report(r: &common::Resp) -> serde_json::Value {
-    assert_eq!(r.status, 200, "{}", r.text());
-    let ct = r.header("content-type").unwrap().to_string();
-    let boundary = ct.split("boundary=").nth(1).unwrap().trim_matches('"').to_string();
-    let text = String::from_utf8_lossy(&r.body).to_string();
-    // The first part of the multipart/mixed answer is the report (JSON).
-    let first = text.split(&format!("--{boundary}")).nth(1).unwrap();
-    let json = &first[first.find("\r\n\r\n").unwrap() + 4..];
-    serde_json::from_str(json.trim_end()).unwrap()
-}
 
 #[test]
 fn crossing_circles_in_every_curve_format() {
@@ -44,7 +20,7 @@ fn crossing_circles_in_every_curve_format() {
         ("c.glb", write(&mesh, Format::Glb).unwrap()),
         ("c.json", json.into_bytes()),
     ] {
-        let r = report(&fit(&s, name, &bytes));
+        let r = inline_report(&post_fit_on_icosphere(&s, name, &bytes, "{}"));
         assert_eq!(r["regions"], 8, "{name}: {}", r["network"]);
         assert_eq!(r["network"]["crossings_inserted"], 6, "{name}");
         assert_eq!(r["segments_as_edges"], 1.0, "{name}");
@@ -60,7 +36,7 @@ fn malformed_curve_files_are_problems_naming_where() {
         ("c.obj", b"v 0 0 0\nv 1 0 0\nl 1 2\nl 2 7\n", "line 4"),
     ];
     for (name, bytes, where_) in cases {
-        let r = fit(&s, name, bytes);
+        let r = post_fit_on_icosphere(&s, name, bytes, "{}");
         assert!((400..500).contains(&r.status), "{name}: {} {}", r.status, r.text());
         assert_eq!(r.header("content-type"), Some("application/problem+json"));
         let p = r.json();

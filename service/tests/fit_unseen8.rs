@@ -5,35 +5,10 @@
 
 mod common;
 
-use common::{file_part, json_part, Server};
+use common::{inline_report, post_fit_on_icosphere, Server};
 use meshwork_core::fit::testdata::{ellipsoid_sections, gltf_strips_with_nodes};
-use meshwork_core::io::{write, Format};
-use meshwork_core::shapes::icosphere;
 
 const AXES: [f64; 3] = [1.4, 1.15, 0.9];
-
-fn post(s: &Server, curves: &[u8], params: &str) -> common::Resp {
-    let template = write(&icosphere(3, 1.0), Format::Obj).unwrap();
-    s.post_multipart(
-        "/v1/fit?format=obj&report=inline",
-        &[
-            file_part("template", "sphere.obj", &template),
-            file_part("curves", "c.gltf", curves),
-            json_part("params", params),
-        ],
-    )
-}
-
-/// The report: the first part of the multipart/mixed answer.
-fn report(r: &common::Resp) -> serde_json::Value {
-    assert_eq!(r.status, 200, "{}", r.text());
-    let ct = r.header("content-type").unwrap().to_string();
-    let boundary = ct.split("boundary=").nth(1).unwrap().trim_matches('"').to_string();
-    let text = String::from_utf8_lossy(&r.body).to_string();
-    let first = text.split(&format!("--{boundary}")).nth(1).unwrap();
-    let json = &first[first.find("\r\n\r\n").unwrap() + 4..];
-    serde_json::from_str(json.trim_end()).unwrap()
-}
 
 #[test]
 fn gltf_strips_under_node_transforms_in_other_units() {
@@ -44,7 +19,7 @@ fn gltf_strips_under_node_transforms_in_other_units() {
         .iter()
         .map(|l| l.iter().map(|&v| c.positions[v as usize].map(|x| x * 100.0)).collect())
         .collect();
-    let r = report(&post(&s, &gltf_strips_with_nodes(&lines), "{}"));
+    let r = inline_report(&post_fit_on_icosphere(&s, "c.gltf", &gltf_strips_with_nodes(&lines), "{}"));
     assert_eq!(r["regions"], 8, "{}", r["network"]);
     assert_eq!(r["segments_as_edges"], 1.0);
     assert_eq!(r["flipped_faces"], 0);
@@ -63,7 +38,7 @@ fn a_pair_point_at_1e300_is_a_problem_naming_the_pair() {
         {"template_vertex": 5, "curve_point": [0, 1.15, 0]},
         {"template_vertex": 9, "curve_point": [0, 0, 0.9]},
         {"template_vertex": 11, "curve_point": [1e300, 0, 0]}]}"#;
-    let r = post(&s, &gltf_strips_with_nodes(&lines), params);
+    let r = post_fit_on_icosphere(&s, "c.gltf", &gltf_strips_with_nodes(&lines), params);
     assert!((400..500).contains(&r.status), "{} {}", r.status, r.text());
     assert_eq!(r.header("content-type"), Some("application/problem+json"));
     let text = r.json().to_string();

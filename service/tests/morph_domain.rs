@@ -7,27 +7,17 @@ mod common;
 
 use std::collections::HashMap;
 use std::path::PathBuf;
-use std::process::{Command, Output};
 
-use common::{file_part, shared_mesh, Server, BIN, TETRA_OBJ};
+use common::{file_part, run_cli as run, shared_mesh, stderr_text as stderr, Server, TETRA_OBJ};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::Mesh;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("run meshwork")
-}
-
 fn dir() -> PathBuf {
-    std::env::temp_dir().join(format!("meshwork-morph-domain-{}", std::process::id()))
+    common::tmp_dir("morph-domain")
 }
 
 fn tmp(name: &str) -> PathBuf {
-    std::fs::create_dir_all(dir()).unwrap();
-    dir().join(name)
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    common::tmp_file("morph-domain", name)
 }
 
 /// Woody with the faces around its interior vertex farthest from the rim removed: a disk with a

@@ -16,6 +16,28 @@ pub fn mesh_bytes(name: &str) -> Vec<u8> {
     std::fs::read(shared_mesh(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// Runs the `meshwork` command line with `args` to its end.
+pub fn run_cli(args: &[&str]) -> std::process::Output {
+    Command::new(BIN).args(args).output().expect("run meshwork")
+}
+
+/// What a finished command wrote to its standard error, as text.
+pub fn stderr_text(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The temporary folder of test file `test` in this process (`meshwork-<test>-<pid>`).
+pub fn tmp_dir(test: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("meshwork-{test}-{}", std::process::id()))
+}
+
+/// `name` in [`tmp_dir`]`(test)`, the folder created on first use.
+pub fn tmp_file(test: &str, name: &str) -> PathBuf {
+    let d = tmp_dir(test);
+    std::fs::create_dir_all(&d).expect("create the test's temporary folder");
+    d.join(name)
+}
+
 pub struct Server {
     pub child: Child,
     pub url: String,
@@ -152,6 +174,31 @@ pub fn multipart(parts: &[Part]) -> (String, Vec<u8>) {
     }
     body.extend_from_slice(format!("--{boundary}--\r\n").as_bytes());
     (format!("multipart/form-data; boundary={boundary}"), body)
+}
+
+/// Posts a fit of the level-3 unit icosphere (as OBJ) to the curve file `curves` named
+/// `curves_name` (its extension picks the reader) with `params` (JSON text), asking for an OBJ and
+/// the report inline.
+pub fn post_fit_on_icosphere(s: &Server, curves_name: &str, curves: &[u8], params: &str) -> Resp {
+    let sphere = meshwork_core::shapes::icosphere(3, 1.0);
+    let template =
+        meshwork_core::io::write(&sphere, meshwork_core::io::Format::Obj).expect("OBJ of an icosphere");
+    s.post_multipart(
+        "/v1/fit?format=obj&report=inline",
+        &[
+            file_part("template", "sphere.obj", &template),
+            file_part("curves", curves_name, curves),
+            json_part("params", params),
+        ],
+    )
+}
+
+/// The report of a job answered with `report=inline`: the first part (JSON) of the
+/// multipart/mixed answer, after checking the status is 200.
+pub fn inline_report(r: &Resp) -> serde_json::Value {
+    assert_eq!(r.status, 200, "{}", r.text());
+    let parts = split_mixed(r.header("content-type").expect("content-type"), &r.body);
+    serde_json::from_slice(&parts[0].1).expect("the first part is the JSON report")
 }
 
 /// Splits a `multipart/mixed` response into (headers, body) parts.
