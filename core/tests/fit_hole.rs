@@ -23,26 +23,9 @@ fn fit(template: Mesh, curves: Mesh, params: serde_json::Value) -> Output {
     job::run(JobKind::Fit, vec![template, curves], params, &Progress::new()).unwrap()
 }
 
-/// Boundary loops of a triangle mesh (directed edges without their reverse, followed).
+/// Boundary loops of the mesh, by `core::topology` (not part of the fit under test).
 fn boundary_loops(m: &Mesh) -> usize {
-    let tris = m.faces.triangles();
-    let directed: std::collections::HashSet<(u32, u32)> =
-        tris.iter().flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3]))).collect();
-    let next: std::collections::HashMap<u32, u32> =
-        directed.iter().filter(|&&(a, b)| !directed.contains(&(b, a))).copied().collect();
-    let mut seen = std::collections::HashSet::new();
-    let mut loops = 0;
-    for &s in next.keys() {
-        if seen.contains(&s) {
-            continue;
-        }
-        loops += 1;
-        let mut v = s;
-        while seen.insert(v) {
-            v = next[&v];
-        }
-    }
-    loops
+    meshwork_core::topology::Topology::new(m).boundary_loops().len()
 }
 
 /// Input segments (consecutive polyline points) whose middle is farther than 0.1 × their length

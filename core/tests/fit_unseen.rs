@@ -66,34 +66,9 @@ fn octants() -> Mesh {
     ellipsoid_sections(AXES, 6)
 }
 
-/// Boundary loops of a triangle mesh (edges used once, followed from vertex to vertex).
+/// Boundary loops of the mesh, by `core::topology` (not part of the fit under test).
 fn boundary_loops(m: &Mesh) -> usize {
-    let mut next = std::collections::HashMap::new();
-    let tris = m.faces.triangles();
-    let mut directed = std::collections::HashSet::new();
-    for t in &tris {
-        for k in 0..3 {
-            directed.insert((t[k], t[(k + 1) % 3]));
-        }
-    }
-    for &(a, b) in &directed {
-        if !directed.contains(&(b, a)) {
-            next.insert(a, b);
-        }
-    }
-    let mut loops = 0;
-    let mut seen = std::collections::HashSet::new();
-    for &s in next.keys() {
-        if seen.contains(&s) {
-            continue;
-        }
-        loops += 1;
-        let mut v = s;
-        while seen.insert(v) {
-            v = next[&v];
-        }
-    }
-    loops
+    meshwork_core::topology::Topology::new(m).boundary_loops().len()
 }
 
 #[test]

@@ -3,9 +3,8 @@
 //! repaired shared meshes in pieces as templates. Truths: the octants (8), two sets of octants
 //! (16), the cube's 6 faces, the UV sphere's 8 octants, each counted by hand.
 
-use std::f64::consts::PI;
 
-use meshwork_core::fit::testdata::{disjoint_union, ellipsoid_sections, polylines, with_holes};
+use meshwork_core::fit::testdata::{disjoint_union, ellipsoid_sections, polylines, uv_sphere, with_holes};
 use meshwork_core::geometry::norm;
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
@@ -46,33 +45,6 @@ fn cube_sphere(n: usize, r: f64) -> Mesh {
         }
     }
     Mesh::new(pos, faces)
-}
-
-/// A UV sphere with triangle fans at the poles (pole valence `nu`).
-fn uv_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
-    let mut pos = vec![[0.0, 0.0, -r]];
-    for j in 1..nv {
-        let lat = -PI / 2.0 + PI * j as f64 / nv as f64;
-        for i in 0..nu {
-            let t = 2.0 * PI * i as f64 / nu as f64;
-            pos.push([r * lat.cos() * t.cos(), r * lat.cos() * t.sin(), r * lat.sin()]);
-        }
-    }
-    pos.push([0.0, 0.0, r]);
-    let top = (pos.len() - 1) as u32;
-    let id = |i: usize, j: usize| (1 + (j - 1) * nu + i % nu) as u32;
-    let mut tris = Vec::new();
-    for i in 0..nu {
-        tris.push([0, id(i + 1, 1), id(i, 1)]);
-        tris.push([top, id(i, nv - 1), id(i + 1, nv - 1)]);
-    }
-    for j in 1..nv - 1 {
-        for i in 0..nu {
-            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    Mesh::from_triangles(pos, &tris)
 }
 
 /// Two unit icospheres `dx` apart along x, each with its own copy of `curves`.
@@ -178,7 +150,7 @@ pub fn layouts() -> Vec<Case> {
 
     out.push(case(
         "UV sphere (pole valence 32), 4 meridians + equator",
-        || fit_inputs(uv_sphere(32, 16, 1.0), polylines(&equator_and_meridians(4, 0.3, 0.1))),
+        || fit_inputs(uv_sphere(32, 16, 1.0, false), polylines(&equator_and_meridians(4, 0.3, 0.1))),
         json!({}),
         Expect::Fit(Some(8)),
     ));

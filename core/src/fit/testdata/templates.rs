@@ -127,17 +127,17 @@ pub fn with_zero_area_face(levels: u32) -> Mesh {
     Mesh::from_triangles(pos, &out)
 }
 
-/// A closed UV sphere of radius `r` about the origin: `nu` segments, `nv` rings (every other ring
-/// turned by half a segment), triangle fans at the poles; 2·nu·(nv − 1) faces. With many segments
-/// and few rings every face is a needle (nu = 512, nv = 6: ~0.012 wide, ~0.52 tall): a template
-/// of long thin triangles, like a CAD tessellation.
-pub fn needle_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
+/// A closed UV sphere of radius `r` about the origin: `nu` segments, `nv` rings, triangle fans
+/// at the poles (pole valence `nu`); 2·nu·(nv − 1) faces. `staggered` turns every other ring by
+/// half a segment.
+pub fn uv_sphere(nu: usize, nv: usize, r: f64, staggered: bool) -> Mesh {
     use std::f64::consts::{FRAC_PI_2, PI};
+    let stagger = if staggered { 0.5 } else { 0.0 };
     let mut pos = vec![[0.0, 0.0, -r]];
     for j in 1..nv {
         let lat = -FRAC_PI_2 + PI * j as f64 / nv as f64;
         for i in 0..nu {
-            let t = 2.0 * PI * (i as f64 + 0.5 * (j % 2) as f64) / nu as f64;
+            let t = 2.0 * PI * (i as f64 + stagger * (j % 2) as f64) / nu as f64;
             pos.push([r * lat.cos() * t.cos(), r * lat.cos() * t.sin(), r * lat.sin()]);
         }
     }
@@ -156,4 +156,11 @@ pub fn needle_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
         }
     }
     Mesh::from_triangles(pos, &tris)
+}
+
+/// A staggered UV sphere ([`uv_sphere`]). With many segments and few rings every face is a
+/// needle (nu = 512, nv = 6: ~0.012 wide, ~0.52 tall): a template of long thin triangles, like
+/// a CAD tessellation.
+pub fn needle_sphere(nu: usize, nv: usize, r: f64) -> Mesh {
+    uv_sphere(nu, nv, r, true)
 }
