@@ -3,7 +3,6 @@
 //! repaired shared meshes in pieces as templates. Truths: the octants (8), two sets of octants
 //! (16), the cube's 6 faces, the UV sphere's 8 octants, each counted by hand.
 
-
 use meshwork_core::fit::testdata::{disjoint_union, ellipsoid_sections, polylines, uv_sphere, with_holes};
 use meshwork_core::geometry::norm;
 use meshwork_core::mesh::{Mesh, Point3};
