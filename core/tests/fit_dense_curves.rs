@@ -15,8 +15,9 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
+use meshwork_core::fit::testdata::{ellipsoid_outward, faces_against};
 use meshwork_core::fit::{run, Alignment, FitParams};
-use meshwork_core::geometry::{dist, dot, norm, triangle_cross};
+use meshwork_core::geometry::{dist, norm};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::{fan_triangles, icosphere};
 use meshwork_core::spatial::closest_on_triangle;
@@ -144,16 +145,8 @@ fn fit_and_check(c: Case) {
     }
     // No face opposes the ellipsoid's outward normal at its centroid (∇F there).
     let out_tris = fan_triangles(&m.faces);
-    let c_axes = c.axes;
-    let against = out_tris
-        .iter()
-        .filter(|t| {
-            let [a, b, c] = t.map(|v| m.positions[v as usize]);
-            let g = |k: usize| (a[k] + b[k] + c[k]) / c_axes[k].powi(2);
-            dot(triangle_cross(a, b, c), [g(0), g(1), g(2)]) <= 0.0
-        })
-        .count();
-    assert_eq!(against, 0, "faces against the ellipsoid's normal");
+    let against = faces_against(m, ellipsoid_outward(c.axes));
+    assert!(against.is_empty(), "faces against the ellipsoid's normal: {against:?}");
     // Near the ellipsoid: within twice the distance of the template's own connectivity inscribed
     // in it (its vertices scaled onto the ellipsoid; the flat faces' sagitta). The curves pin the
     // surface only along them, so between them it is as far as such faces, a little more where the

@@ -2,9 +2,10 @@
 //! analytic ellipsoid (curves on it, surface near it, 8 octant regions).
 
 use meshwork_core::fit::testdata::{ellipsoid_distance, ellipsoid_sections};
+use meshwork_core::fit::testdata::{ellipsoid_outward, faces_against};
 use meshwork_core::fit::{run, Alignment, FitPair, FitParams};
+use meshwork_core::geometry::dist;
 use meshwork_core::geometry::signed_volume;
-use meshwork_core::geometry::{dist, dot, triangle_cross};
 use meshwork_core::shapes::icosphere;
 use meshwork_core::Progress;
 
@@ -25,22 +26,8 @@ fn check(out: &meshwork_core::Output) -> (f64, f64) {
     assert_eq!(r["regions"], 8);
     assert_eq!(m.groups.len(), 8);
     // Flipped faces by the analytic outward normal (not the job's own measure).
-    let flipped = m
-        .faces
-        .iter()
-        .filter(|f| {
-            let (a, b, c) =
-                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
-            let n = triangle_cross(a, b, c);
-            let g = [
-                (a[0] + b[0] + c[0]) / AXES[0].powi(2),
-                (a[1] + b[1] + c[1]) / AXES[1].powi(2),
-                (a[2] + b[2] + c[2]) / AXES[2].powi(2),
-            ];
-            dot(n, g) <= 0.0
-        })
-        .count();
-    assert_eq!(flipped, 0);
+    let against = faces_against(m, ellipsoid_outward(AXES));
+    assert!(against.is_empty(), "faces against the ellipsoid's normal: {against:?}");
     // Every curve point is a vertex of the output (exactly), and the output curves are edge chains.
     let curves = ellipsoid_sections(AXES, 10);
     for p in &curves.positions {

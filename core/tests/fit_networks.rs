@@ -6,8 +6,9 @@
 
 use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
 use meshwork_core::fit::testdata::{arc, circle, ellipsoid_sections, great_circles, loxodrome, polylines};
+use meshwork_core::fit::testdata::{ellipsoid_outward, faces_against};
 use meshwork_core::fit::{run, FitParams};
-use meshwork_core::geometry::{dist, dot, norm, triangle_cross};
+use meshwork_core::geometry::{dist, norm};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::icosphere;
 use meshwork_core::{Output, Progress};
@@ -24,15 +25,7 @@ fn fit(curves: Mesh, params: &FitParams) -> Output {
 
 /// Faces whose normal points into the sphere (the analytic outward normal is the position).
 fn inward_faces(m: &Mesh) -> usize {
-    m.faces
-        .iter()
-        .filter(|f| {
-            let (a, b, c) =
-                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
-            let centroid = [a[0] + b[0] + c[0], a[1] + b[1] + c[1], a[2] + b[2] + c[2]];
-            dot(triangle_cross(a, b, c), centroid) <= 0.0
-        })
-        .count()
+    faces_against(m, ellipsoid_outward([1.0; 3])).len()
 }
 
 /// The checks every case shares: all segments are edge chains, no face turned inward, `regions`

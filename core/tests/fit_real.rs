@@ -5,9 +5,10 @@
 
 use meshwork_core::fit::kdtree::KdTree;
 use meshwork_core::fit::smooth::closest_on_triangle;
+use meshwork_core::fit::testdata::faces_against;
 use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, section_regions, thin_network};
 use meshwork_core::fit::{run, FitParams};
-use meshwork_core::geometry::{dist, dot, triangle_cross, Aabb};
+use meshwork_core::geometry::{dist, triangle_cross, Aabb};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::shapes::{fan_triangles, subdivide_midpoint};
@@ -86,27 +87,16 @@ fn homer_fits_sections_of_its_bent_self() {
     );
 
     // Faces flipped against the truth: output normal vs the truth normal nearest to it.
-    let flipped = m
-        .faces
-        .iter()
-        .filter(|f| {
-            let (a, b, c) =
-                (m.positions[f[0] as usize], m.positions[f[1] as usize], m.positions[f[2] as usize]);
-            let centroid =
-                [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0, (a[2] + b[2] + c[2]) / 3.0];
-            let (v, _) = tree.nearest(centroid).unwrap();
-            let tn = vf[v as usize].iter().fold([0.0; 3], |acc, &g| {
-                let t = truth_tris[g as usize];
-                let n = triangle_cross(
-                    truth_pos[t[0] as usize],
-                    truth_pos[t[1] as usize],
-                    truth_pos[t[2] as usize],
-                );
-                [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
-            });
-            dot(triangle_cross(a, b, c), tn) < 0.0
+    let flipped = faces_against(m, |centroid| {
+        let (v, _) = tree.nearest(centroid).unwrap();
+        vf[v as usize].iter().fold([0.0; 3], |acc, &g| {
+            let t = truth_tris[g as usize];
+            let n =
+                triangle_cross(truth_pos[t[0] as usize], truth_pos[t[1] as usize], truth_pos[t[2] as usize]);
+            [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
         })
-        .count();
+    })
+    .len();
     eprintln!("faces opposing the truth normal: {flipped}");
 
     // Every matched curve vertex is exactly on the output.

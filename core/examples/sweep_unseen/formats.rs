@@ -2,6 +2,7 @@
 //! corners, a soup welded on read; ASCII), OFF, glTF and GLB, written by our own writer or by hand,
 //! and a repaired shared mesh carried through STL (f32 rounding of every vertex).
 
+use meshwork_core::fit::testdata::{ascii_stl, binary_ply};
 use meshwork_core::io::{write, Format};
 use meshwork_core::mesh::Mesh;
 use meshwork_core::shapes::icosphere;
@@ -13,46 +14,6 @@ use crate::support::{case, read_as, repaired, sections_of, sphere_sections, to_u
 fn through(m: &Mesh, format: Format) -> Result<Mesh, Error> {
     let bytes = write(m, format)?;
     read_as(&bytes, &format!("t.{}", format.extension()))
-}
-
-/// An icosphere as a hand-written binary little-endian PLY (float vertices, uchar/int lists).
-fn binary_ply(m: &Mesh) -> Vec<u8> {
-    let tris = m.faces.triangles();
-    let mut b = format!(
-        "ply\nformat binary_little_endian 1.0\ncomment made by sweep_unseen\nelement vertex {}\n\
-         property float x\nproperty float y\nproperty float z\nelement face {}\n\
-         property list uchar int vertex_indices\nend_header\n",
-        m.positions.len(),
-        tris.len()
-    )
-    .into_bytes();
-    for p in &m.positions {
-        for c in p {
-            b.extend_from_slice(&(*c as f32).to_le_bytes());
-        }
-    }
-    for t in &tris {
-        b.push(3);
-        for v in t {
-            b.extend_from_slice(&(*v as i32).to_le_bytes());
-        }
-    }
-    b
-}
-
-/// An icosphere as hand-written ASCII STL (every facet its own corners, normals zero).
-fn ascii_stl(m: &Mesh) -> Vec<u8> {
-    let mut s = String::from("solid sphere\n");
-    for t in m.faces.triangles() {
-        s += "  facet normal 0 0 0\n    outer loop\n";
-        for v in t {
-            let p = m.positions[v as usize];
-            s += &format!("      vertex {:e} {:e} {:e}\n", p[0], p[1], p[2]);
-        }
-        s += "    endloop\n  endfacet\n";
-    }
-    s += "endsolid sphere\n";
-    s.into_bytes()
 }
 
 pub fn formats() -> Vec<Case> {

@@ -157,6 +157,7 @@ fn main() {
                         r["retriangulation"]
                     );
                     eprintln!("  stages {}; fine {}", r["stages"], r["fine"]);
+                    eprintln!("  zero-area faces {}", r["zero_area_faces"]);
                 }
                 let off = r["retriangulation"]["off_surface_segments"].as_u64().unwrap_or(0);
                 let status = match (bad.is_empty(), r["retriangulation"]["failed_pieces"].as_u64()) {

@@ -205,6 +205,31 @@ mod tests {
         }
     }
 
+    #[test]
+    fn a_strip_whose_cut_passes_through_a_vertex_is_not_split_there() {
+        // The strip of the test above with vertex 3 moved onto the segment's line, to (1.5, 0):
+        // the cutting plane (y = 0) crosses edge 3–2 exactly at vertex 3 (fraction 0, hand
+        // value). A split there would add a vertex at vertex 3's place and two zero-area faces;
+        // the strip is refused with nothing changed, so the fallback realises the segment.
+        let pos = vec![
+            [0.0, 0.0, 0.0],
+            [0.5, 1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.5, 0.0, 0.0],
+            [2.0, -1.0, 0.0],
+            [3.0, 0.0, 0.0],
+        ];
+        let tris = vec![[0, 2, 1], [1, 2, 3], [2, 4, 3], [3, 4, 5]];
+        let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
+        let cut = Cut { a: [0.0; 3], dir: [1.0, 0.0, 0.0], side: [0.0, 1.0, 0.0], len: 3.0 };
+        assert_eq!(super::cut::crossing(&mesh, &cut, 3, 2).1, 0.0);
+        let crossed = [(1, 2), (3, 2), (3, 4)];
+        let (mut on_curve, mut added, mut chain) = (vec![false; 6], Vec::new(), vec![0]);
+        assert!(!split_strip(&mut mesh, &cut, &crossed, &mut on_curve, &mut added, &mut chain));
+        assert_eq!((mesh.live_triangles(), mesh.pos), (tris, pos));
+        assert_eq!((chain, added.len(), on_curve.len()), (vec![0], 0, 6));
+    }
+
     /// The n × n unit grid of triangles in z = 0 (vertex (i, j) = j(n+1) + i at (i, j, 0)).
     fn grid_mesh(n: usize) -> TriMesh {
         let g = crate::shapes::grid(n, n, 1.0, false);

@@ -9,7 +9,8 @@ use super::super::trimesh::TriMesh;
 use super::cut::{crossing, Cut};
 use super::route;
 
-/// stays valid up to its last vertex).
+/// Splits the edges a walked strip crosses where the cutting plane crosses them, pushing the new
+/// vertices onto `chain`; false, with nothing changed, when a crossing lies at an edge's end.
 pub(super) fn split_strip(
     mesh: &mut TriMesh,
     cut: &Cut,
@@ -22,7 +23,24 @@ pub(super) fn split_strip(
     // the split faces where the strip is long and curved.
     let crossings: Vec<route::Crossing> =
         crossed.iter().map(|&(l, r)| route::Crossing { l, r, lam: crossing(mesh, cut, l, r).1 }).collect();
+    // A crossing at an edge's end is the cutting plane passing through a vertex (one lying
+    // exactly on the segment's line, e.g. a chain vertex of the collinear next segment): a split
+    // there would make a second vertex at that place and two zero-area faces. Refused before
+    // anything changes; the segment's fallback (a vertex path or a route kept off edge ends)
+    // realises it instead.
+    if crossings.iter().any(|c| at_an_end(c.lam)) {
+        return false;
+    }
     split_crossings(mesh, &crossings, on_curve, added, chain)
+}
+
+/// Edge fractions this close to 0 or 1 are the edge's end: a split there makes an edge of at
+/// most this fraction of the crossed edge, zero at double precision (measured: exactly 0 when
+/// the vertex lies on the cutting plane, 7e-15 when one round-off off it).
+const AT_END: f64 = 1e-9;
+
+fn at_an_end(lam: f64) -> bool {
+    !(AT_END..=1.0 - AT_END).contains(&lam)
 }
 
 /// Splits each crossed edge in order at its fraction, pushing the new vertices onto `chain`

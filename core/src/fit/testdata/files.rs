@@ -1,5 +1,6 @@
 //! Curve files written the way other programs write them: glTF LINES / LINE_STRIP / LINE_LOOP
-//! (one primitive, or one node with a transform per polyline), OBJ `l` with negative indices.
+//! (one primitive, or one node with a transform per polyline), OBJ `l` with negative indices; and
+//! templates as scanners and CAD tools write them (binary PLY of f32, an ASCII STL soup).
 
 use crate::io::gltf::base64::encode as base64;
 use crate::mesh::{Mesh, Point3};
@@ -110,5 +111,46 @@ pub fn obj_negative_indices(curves: &Mesh) -> Vec<u8> {
         }
         s += "\n";
     }
+    s.into_bytes()
+}
+
+/// A triangle mesh as a hand-written binary little-endian PLY (float vertices, uchar/int lists),
+/// as scanners write it.
+pub fn binary_ply(m: &Mesh) -> Vec<u8> {
+    let tris = m.faces.triangles();
+    let mut b = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment made by meshwork testdata\nelement vertex {}\n\
+         property float x\nproperty float y\nproperty float z\nelement face {}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        m.positions.len(),
+        tris.len()
+    )
+    .into_bytes();
+    for p in &m.positions {
+        for c in p {
+            b.extend_from_slice(&(*c as f32).to_le_bytes());
+        }
+    }
+    for t in &tris {
+        b.push(3);
+        for v in t {
+            b.extend_from_slice(&(*v as i32).to_le_bytes());
+        }
+    }
+    b
+}
+
+/// A triangle mesh as hand-written ASCII STL: a soup (every facet its own corners), normals zero.
+pub fn ascii_stl(m: &Mesh) -> Vec<u8> {
+    let mut s = String::from("solid mesh\n");
+    for t in m.faces.triangles() {
+        s += "  facet normal 0 0 0\n    outer loop\n";
+        for v in t {
+            let p = m.positions[v as usize];
+            s += &format!("      vertex {:e} {:e} {:e}\n", p[0], p[1], p[2]);
+        }
+        s += "    endloop\n  endfacet\n";
+    }
+    s += "endsolid mesh\n";
     s.into_bytes()
 }

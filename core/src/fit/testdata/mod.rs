@@ -7,16 +7,19 @@
 //!   polylines, jitter, arcs whose ends miss;
 //! - [`templates`]: templates beyond the icosphere (cylinder, paraboloid with a hole, n-gon sphere)
 //!   and mesh edits (holes, two meshes as one, a zero-area face);
+//! - [`checks`]: checks of an output against the truth (faces turned against its normal);
 //! - [`files`]: curve files as other programs write them (glTF lines with and without node
 //!   transforms, OBJ negative indices).
 //!
 //! Everything is re-exported here, so `fit::testdata::circle` names it whatever its family.
 
+pub mod checks;
 pub mod curves;
 pub mod files;
 pub mod sections;
 pub mod templates;
 
+pub use checks::*;
 pub use curves::*;
 pub use files::*;
 pub use sections::*;
