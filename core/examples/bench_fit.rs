@@ -7,6 +7,8 @@
 //! Run from the repository root (reads `../shared/meshes/homer.obj`) with a private release target dir
 //! (see docs/benchmarks.md → Fit: the shared one mixes worktrees' builds of this example):
 //! `CARGO_TARGET_DIR=/tmp/fit-rel cargo run --release -p meshwork-core --example bench_fit`
+//! (`--stage-cpu [RUNS]`: the headline with smoothing only, CPU time per stage and a digest of the
+//! output, for comparing two builds under load.)
 
 use std::time::Instant;
 
@@ -461,6 +463,11 @@ fn main() {
         }
         return;
     }
+    if let Some(i) = std::env::args().position(|a| a == "--stage-cpu") {
+        let runs = std::env::args().nth(i + 1).and_then(|n| n.parse().ok()).unwrap_or(3);
+        stage_cpu(&case(&homer, 2, 1, true, true), runs);
+        return;
+    }
     println!(
         "== headline: 96k-vertex template, full section network ({} regions expected, counted by \
          testdata::section_regions) ==",
@@ -495,6 +502,71 @@ fn main() {
     println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
     let c = case(&homer, 2, 1, true, false);
     rbf_peer(&c);
+}
+
+/// CPU time of all threads of this process so far (0 where /proc cannot tell): under load the
+/// wall time mostly measures waiting for a core, this the work done.
+fn process_cpu() -> std::time::Duration {
+    let ns: u64 = std::fs::read_dir("/proc/self/task")
+        .map(|d| {
+            d.filter_map(|t| t.ok())
+                .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
+                .filter_map(|s| s.split_whitespace().next().and_then(|v| v.parse::<u64>().ok()))
+                .sum()
+        })
+        .unwrap_or(0);
+    std::time::Duration::from_nanos(ns)
+}
+
+/// `--stage-cpu [RUNS]`: the headline with smoothing, run RUNS times, each with its wall time, its
+/// CPU time (all threads) per stage and in all, and a digest of the output (positions' bits,
+/// faces, groups, curves) so that two builds can be shown to give the same mesh. A stage's CPU
+/// runs from its entry to the next stage's, so the unstaged work between two stages counts for
+/// the first (the listener sees stage entries and fractions only).
+fn stage_cpu(c: &Case, runs: usize) {
+    use std::hash::{Hash, Hasher};
+    use std::sync::{Arc, Mutex};
+    for _ in 0..runs {
+        let progress = Progress::new();
+        let marks: Arc<Mutex<Vec<(String, std::time::Duration)>>> = Arc::default();
+        let m = marks.clone();
+        progress.set_listener(move |stage, _| {
+            let mut m = m.lock().unwrap();
+            if m.last().is_none_or(|l| l.0 != stage) {
+                m.push((stage.to_string(), process_cpu()));
+            }
+        });
+        let (t, cpu0) = (Instant::now(), process_cpu());
+        let out = run(vec![c.template.clone(), c.curves.clone()], &c.params, &progress).expect("fit");
+        let (wall, cpu_end) = (t.elapsed().as_secs_f64(), process_cpu());
+        let marks = marks.lock().unwrap().clone();
+        let mut per_stage = Vec::new();
+        for (i, (stage, at)) in marks.iter().enumerate() {
+            let next = marks.get(i + 1).map_or(cpu_end, |m| m.1);
+            per_stage.push(format!("{stage} {:.0}", next.saturating_sub(*at).as_secs_f64() * 1e3));
+        }
+        let mesh = &out.meshes[0];
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for p in &mesh.positions {
+            p.map(f64::to_bits).hash(&mut h);
+        }
+        for f in 0..mesh.face_count() {
+            (mesh.faces.get(f), mesh.faces.group(f)).hash(&mut h);
+        }
+        mesh.curves.hash(&mut h);
+        let r = &out.report;
+        println!(
+            "wall {wall:.3} s cpu {:.3} s | edges {:.4} flipped {} regions {} V {} F {} digest {:016x} | cpu ms: {}",
+            cpu_end.saturating_sub(cpu0).as_secs_f64(),
+            r["segments_as_edges"].as_f64().unwrap_or(0.0),
+            r["flipped_faces"],
+            r["regions"],
+            mesh.vertex_count(),
+            mesh.face_count(),
+            h.finish(),
+            per_stage.join(", ")
+        );
+    }
 }
 
 /// Times our RBF (solve + evaluate at every template vertex) and SciPy's on the same centres.

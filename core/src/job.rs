@@ -29,9 +29,13 @@ struct ProgressInner {
     /// Calls of [`Progress::check`] so far, and the call at which to cancel (0: none).
     checks: AtomicU64,
     cancel_at_check: AtomicU64,
+    /// Called at every poll ([`Progress::set_poll_listener`]); the flag spares the lock when unset.
+    poll_listener: Mutex<Option<PollListener>>,
+    has_poll_listener: AtomicBool,
 }
 
 type Listener = Box<dyn Fn(&str, f64) + Send + Sync>;
+type PollListener = Box<dyn Fn() + Send + Sync>;
 
 impl Progress {
     pub fn new() -> Self {
@@ -59,6 +63,14 @@ impl Progress {
         *lock(&self.inner.listener) = Some(Box::new(f));
     }
 
+    /// Called at every poll ([`Progress::check`], directly or through `stage`/`fraction`), before
+    /// the cancel test: a measuring tool's hook (`cancel_latency`'s `CANCEL_GAPS` times the work
+    /// between two polls, which is what bounds a cancel's overshoot), not a progress display.
+    pub fn set_poll_listener(&self, f: impl Fn() + Send + Sync + 'static) {
+        *lock(&self.inner.poll_listener) = Some(Box::new(f));
+        self.inner.has_poll_listener.store(true, Ordering::Relaxed);
+    }
+
     pub fn cancel(&self) {
         self.inner.cancelled.store(true, Ordering::Relaxed);
     }
@@ -69,6 +81,11 @@ impl Progress {
 
     /// Err when the job should stop now: cancelled or past its deadline.
     pub fn check(&self) -> Result<()> {
+        if self.inner.has_poll_listener.load(Ordering::Relaxed) {
+            if let Some(l) = lock(&self.inner.poll_listener).as_ref() {
+                l();
+            }
+        }
         let n = self.inner.checks.fetch_add(1, Ordering::Relaxed) + 1;
         if n == self.inner.cancel_at_check.load(Ordering::Relaxed) {
             self.cancel();

@@ -201,7 +201,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         for &v in &fine.vertex_of_point {
             fixed[v as usize] = true;
         }
-        Ok(untangle::untangle(&mut mesh, &reference, &fixed, &untangle::EdgeSet::default(), 8))
+        untangle::untangle_polled(&mut mesh, &reference, &fixed, &untangle::EdgeSet::default(), 8, progress)
     })?;
     let tris = mesh.live_triangles();
 
@@ -272,6 +272,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     }
     let retri_tris = mesh.live_triangles();
     let angles_retri = report::angle_stats(&mesh.pos, &retri_tris);
+    // The unstaged passes over all faces between two stages poll too (each ~10–20 ms on the
+    // headline; together they were most of the longest stretches without a poll, session 10).
+    progress.check()?;
     let (region0, mut region_count) = stages
         .run(progress, "partition", || partition::regions_polled(&retri_tris, &curve_edges, progress))?;
     // Label of every face id: region × template group, kept by the clean-up.
@@ -285,6 +288,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         labels[f as usize] = ((r as u64) << 32) | g as u64;
     }
     // (A sort of the live faces' edges, not a hash lookup per vertex: ~3 % of the headline.)
+    progress.check()?;
     let boundary = trimesh::boundary_vertices(mesh.pos.len(), &retri_tris);
     drop(retri_tris);
     let fixed: Vec<bool> = (0..mesh.pos.len()).map(|v| realised.on_curve[v] || boundary[v]).collect();
@@ -336,9 +340,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     } else {
         mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
     };
+    progress.check()?;
     let angles_before = report::angle_stats(&mesh.pos, &out_tris);
+    progress.check()?;
     let flipped_before_smoothing = untangle::count_flipped(&mesh.pos, &out_tris, &reference_normals);
+    progress.check()?;
     let folds_before_smoothing = untangle::fold_stats(&mesh.pos, &out_tris);
+    progress.check()?;
     let mut out_pos = mesh.pos.clone();
     let mut smoothing = smooth::SmoothStats::default();
     if params.smooth {
@@ -366,7 +374,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let untangle_smoothed = if params.smooth {
         mesh.pos = out_pos;
         let s = stages.run(progress, "untangle_smoothed", || {
-            Ok(untangle::untangle(&mut mesh, &reference_normals, &realised.on_curve, &curve_edges, 8))
+            untangle::untangle_polled(
+                &mut mesh,
+                &reference_normals,
+                &realised.on_curve,
+                &curve_edges,
+                8,
+                progress,
+            )
         })?;
         out_pos = mesh.pos.clone();
         if s.edge_flips > 0 {

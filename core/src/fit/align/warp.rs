@@ -97,7 +97,7 @@ pub fn warp_icp(
     if !(radius > 0.0) {
         return Ok(report);
     }
-    let mut tracked = TrackedFeet::new(pos, tris, points, &which);
+    let mut tracked = TrackedFeet::new(pos, tris, points, &which, progress)?;
     let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
         let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
         d.sort_by(f64::total_cmp);
@@ -150,6 +150,7 @@ pub fn warp_icp(
         // against the stage's start: when the composed warp folds a face, the longest run of
         // first steps that does not is kept (found by bisection; folds are rare).
         let mut moved = warp.apply_first(warp.steps.len(), progress)?;
+        progress.check()?;
         if super::super::approach::folds(pos, &moved, tris) > 0 {
             report.damped += 1;
             let (mut ok, mut bad) = (0, warp.steps.len());
@@ -174,6 +175,9 @@ pub fn warp_icp(
     report.rms_all_after = (feet.iter().map(|f| f.2 * f.2).sum::<f64>() / feet.len().max(1) as f64).sqrt();
     Ok(report)
 }
+
+/// Faces or vertices handled between two polls while [`TrackedFeet`] builds its adjacency.
+const POLL_ITEMS: usize = 16_384;
 
 /// The warp of one stage as a list of polynomial steps (x ↦ x + Σ cₖ mₖ((x − centre)/radius),
 /// each applied to the result of the ones before), evaluated only at the vertices asked for:
@@ -250,25 +254,36 @@ struct TrackedFeet {
 }
 
 impl TrackedFeet {
-    fn new(pos: &[Point3], tris: &[[u32; 3]], points: &[Point3], which: &[u32]) -> Self {
+    /// Polls every [`POLL_ITEMS`] faces and vertices (on the 96k-vertex template of
+    /// `cancel_latency`, the adjacency and the k-d tree were ~100 ms of CPU without a poll).
+    fn new(
+        pos: &[Point3],
+        tris: &[[u32; 3]],
+        points: &[Point3],
+        which: &[u32],
+        progress: &Progress,
+    ) -> Result<Self> {
         let mut vf: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
         let mut vv: Vec<Vec<u32>> = vec![Vec::new(); pos.len()];
         for (f, t) in tris.iter().enumerate() {
+            progress.check_every(f, POLL_ITEMS)?;
             for k in 0..3 {
                 vf[t[k] as usize].push(f as u32);
                 vv[t[k] as usize].push(t[(k + 1) % 3]);
                 vv[t[(k + 1) % 3] as usize].push(t[k]);
             }
         }
-        for n in vv.iter_mut() {
+        for (v, n) in vv.iter_mut().enumerate() {
+            progress.check_every(v, POLL_ITEMS)?;
             n.sort_unstable();
             n.dedup();
         }
+        progress.check()?;
         let mut t =
             TrackedFeet { vf, vv, near: Vec::new(), faces: vec![(u32::MAX, Vec::new()); which.len()] };
         t.near = which.iter().map(|_| u32::MAX).collect();
         t.rebase_with(pos, points, which);
-        t
+        Ok(t)
     }
 
     fn rebase_with(&mut self, pos: &[Point3], points: &[Point3], which: &[u32]) {

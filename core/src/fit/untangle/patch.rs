@@ -19,7 +19,9 @@
 
 use std::collections::HashMap;
 
+use crate::error::Result;
 use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub, triangle_cross};
+use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::super::smooth::min_angle_quality;
@@ -43,12 +45,17 @@ pub(super) struct PatchPass {
     pub uv_batches: Vec<Vec<UvMove>>,
 }
 
-/// One pass over the groups of folded faces of `mesh`.
-pub(super) fn untangle_patches(mesh: &mut TriMesh, ctx: &Ctx) -> PatchPass {
+/// One pass over the groups of folded faces of `mesh` (`bad`: its folded faces, in id order).
+pub(super) fn untangle_patches(
+    mesh: &mut TriMesh,
+    ctx: &Ctx,
+    bad: &[u32],
+    progress: &Progress,
+) -> Result<PatchPass> {
     let mut out = PatchPass::default();
-    let bad: Vec<u32> = mesh.alive_faces().filter(|&f| ctx.folded(mesh, mesh.tris[f as usize])).collect();
     let mut seen: HashMap<u32, ()> = HashMap::new();
-    for &f in &bad {
+    for (i, &f) in bad.iter().enumerate() {
+        progress.check_every(i, super::POLL_FOLDED)?;
         if seen.contains_key(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
             continue;
         }
@@ -61,6 +68,9 @@ pub(super) fn untangle_patches(mesh: &mut TriMesh, ctx: &Ctx) -> PatchPass {
         let mut best: Option<(usize, Vec<(u32, Point3)>)> = None;
         let folded_before = group.len();
         for _ in 0..MAX_RINGS {
+            // A ring's solve can take tens of ms on a patch of thousands of faces (one group's
+            // rings were ~470 ms of CPU without a poll at load 9, session 10).
+            progress.check()?;
             grow(mesh, &mut patch, &mut in_patch);
             if patch.len() > MAX_PATCH_FACES {
                 break;
@@ -88,7 +98,7 @@ pub(super) fn untangle_patches(mesh: &mut TriMesh, ctx: &Ctx) -> PatchPass {
         out.vertices_moved += moves.len();
         out.uv_batches.push(batch);
     }
-    out
+    Ok(out)
 }
 
 /// The folded faces connected to `f` through shared vertices.
