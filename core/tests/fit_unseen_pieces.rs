@@ -8,6 +8,7 @@
 //!   report counts exactly those (`failed_pieces`) and names the reason `pieces` for each.
 
 use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
+use meshwork_core::fit::sheets::Sheets;
 use meshwork_core::fit::testdata::{disjoint_union, plane_sections};
 use meshwork_core::geometry::{dist, Aabb};
 use meshwork_core::job::{self, JobKind, Output};
@@ -93,7 +94,9 @@ fn curves_stay_on_their_piece_when_another_piece_is_nearer_by_vertices() {
 
 /// Two coarse spheres overlapping (centres 1.2 apart, radius 1), as separate components, cut by
 /// the planes z = 0.1237 and y = −0.0531 (both cut both spheres) and x = 0.0713 (the first only).
-/// In each of the two planes the two spheres' circles cross, and the network joins them there:
+/// In each of the two planes the two spheres' circles cross; the network joins them there unless
+/// the template shows the two circles on two sheets passing through each other (`fit::sheets`;
+/// the test builds the network as the fit does): a join is
 /// either a shared crossing vertex on both surfaces, or (a crossing next to a vertex) the other
 /// circle's segment split at that vertex, which lies on one sphere only. Truth, from the
 /// geometry: a segment with no sphere holding both its ends cannot be an edge chain; a point on
@@ -108,7 +111,11 @@ fn segments_between_pieces_no_edge_joins_are_counted_and_named() {
         vec![([0.0, 0.0, 1.0], 0.1237), ([0.0, 1.0, 0.0], -0.0531), ([1.0, 0.0, 0.0], 0.0713)];
     let template = disjoint_union(&a, &b);
     let curves = plane_sections(&template, &planes);
-    let net = CurveNetwork::build(&curves, &NetworkOptions::default()).expect("network");
+    // The network as the fit builds it: the spheres pass through each other, so crossings of
+    // circles that lie on the two spheres there are not joined (`fit::sheets`).
+    let sheets = Sheets::new(&template.positions, &template.faces.triangles());
+    let net = CurveNetwork::build_checked(&curves, &NetworkOptions::default(), &|a, b| sheets.may_join(a, b))
+        .expect("network");
     let on_a: Vec<bool> = net.points.iter().map(|&p| distance_to(&a, p) < 1e-9).collect();
     let on_b: Vec<bool> = net.points.iter().map(|&p| distance_to(&b, p) < 1e-9).collect();
     assert!((0..net.points.len()).all(|p| on_a[p] || on_b[p]), "test set-up: a point off both spheres");

@@ -38,6 +38,7 @@ pub mod rbf;
 pub mod refine;
 pub mod report;
 pub mod retriangulate;
+pub mod sheets;
 pub mod smooth;
 pub mod template;
 pub mod testdata;
@@ -86,14 +87,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         None => params,
     };
     let mut stages = Stages::new();
-    let net = stages.run(progress, "curves", || {
-        let options = curves::NetworkOptions {
-            join_tolerance: params.join_tolerance,
-            merge_tolerance: params.merge_tolerance,
-            junction_tolerance: params.junction_tolerance,
-        };
-        curves::CurveNetwork::build(&curve_mesh, &options)
-    })?;
+    let options = curves::NetworkOptions {
+        join_tolerance: params.join_tolerance,
+        merge_tolerance: params.merge_tolerance,
+        junction_tolerance: params.junction_tolerance,
+    };
+    let net = stages.run(progress, "curves", || curves::CurveNetwork::build(&curve_mesh, &options))?;
     if net.points.len() > params.max_curve_vertices as usize {
         return Err(Error::TooLarge {
             what: "curve vertices (RBF centres)".into(),
@@ -119,8 +118,24 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let given_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
 
-    let coarse =
+    let mut coarse =
         stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
+    // Crossings the network joined are checked against the aligned template: curves on two
+    // sheets of a self-intersecting template are not joined (the network is built again).
+    let net = stages.run(progress, "curves_on_sheets", || {
+        let joined = net.stats.crossings_inserted + net.stats.crossings_at_vertices;
+        if joined == 0 {
+            return Ok(net);
+        }
+        let sheets = sheets::Sheets::new(&pos, &tris);
+        let checked =
+            curves::CurveNetwork::build_checked(&curve_mesh, &options, &|a, b| sheets.may_join(a, b))?;
+        if checked.stats.crossings_on_two_sheets == 0 {
+            return Ok(net);
+        }
+        coarse.pair_curve_points = sheets::renumber_points(&net, &checked, &coarse.pair_curve_points);
+        Ok(checked)
+    })?;
     // Distances from here on (max_curve_distance, end snaps, the relative residual) are measured
     // on the aligned template: an alignment that scales (a template in metres, curves in
     // centimetres) must scale the limits with it, or curves 100× larger are refused as "far"

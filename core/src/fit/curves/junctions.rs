@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use crate::geometry::{add, dist, dot, norm2, scale, sub};
 use crate::mesh::Point3;
 
-use super::{key, Builder};
+use super::{key, Builder, MayJoin};
 
 /// Union-find over point ids; `find` gives the id that keeps its position.
 pub(super) struct Merges(Vec<u32>);
@@ -396,7 +396,7 @@ impl Builder {
     }
 
     /// Step 3c: segments that cross without a shared vertex get one.
-    pub(super) fn insert_crossings(&mut self, tol: f64) {
+    pub(super) fn insert_crossings(&mut self, tol: f64, may_join: &MayJoin<'_>) {
         let segs = self.segments();
         let boxes: Vec<(Point3, Point3)> = segs.iter().map(|&s| self.seg_box(s, tol)).collect();
         let mut nbrs: Vec<Vec<u32>> = vec![Vec::new(); self.points.len()];
@@ -414,6 +414,13 @@ impl Builder {
         let mut merged_any = false;
         let mut pairs = overlapping(&boxes);
         pairs.sort();
+        // Asked only of crossings that pass every other test, so that refusals count crossings.
+        let mut refused = 0;
+        let mut join_ok = |a: [Point3; 2], b: [Point3; 2]| {
+            let ok = may_join(a, b);
+            refused += usize::from(!ok);
+            ok
+        };
         for (i, j) in pairs {
             let (s1, s2) = (segs[i], segs[j]);
             if s1.iter().any(|&v| s2.iter().any(|&w| adj(v, w))) {
@@ -445,6 +452,9 @@ impl Builder {
                     if gap > allowed {
                         continue;
                     }
+                    if !join_ok([a0, a1], [b0, b1]) {
+                        continue;
+                    }
                     let id = self.points.len() as u32;
                     self.points.push(scale(add(x, y), 0.5));
                     m.0.push(id);
@@ -462,7 +472,7 @@ impl Builder {
                     }
                     let u = segment_param(p(v), o0, o1);
                     let gap = dist(p(v), lerp(o0, o1, u));
-                    if gap > allowed || u <= 0.0 || u >= 1.0 {
+                    if gap > allowed || u <= 0.0 || u >= 1.0 || !join_ok([a0, a1], [b0, b1]) {
                         continue;
                     }
                     splits.entry(key(other[0], other[1])).or_default().push((u, v));
@@ -493,12 +503,15 @@ impl Builder {
                     // meridian: merging would pinch one onto the other at every crossing).
                     let split_ok = gap <= allowed && u > 0.0 && u < 1.0 && !adj(x, o[0]) && !adj(x, o[1]);
                     if apart > allowed || (4.0 * gap <= apart && split_ok) {
-                        if !split_ok {
+                        if !split_ok || !join_ok([a0, a1], [b0, b1]) {
                             continue;
                         }
                         splits.entry(key(o[0], o[1])).or_default().push((u, x));
                         self.stats.crossings_at_vertices += 1;
                         self.stats.junction_max_gap = self.stats.junction_max_gap.max(gap);
+                        continue;
+                    }
+                    if !join_ok([a0, a1], [b0, b1]) {
                         continue;
                     }
                     if m.merge(w, v) {
@@ -509,6 +522,7 @@ impl Builder {
                 }
             }
         }
+        self.stats.crossings_on_two_sheets += refused;
         self.apply_splits(splits);
         if merged_any {
             self.apply_merges(&mut m);

@@ -37,6 +37,9 @@ mod junctions;
 pub use json::polylines_from_json;
 use junctions::Merges;
 
+/// Whether two segments (their end points) that cross in space may get a shared vertex.
+pub type MayJoin<'a> = dyn Fn([Point3; 2], [Point3; 2]) -> bool + 'a;
+
 #[derive(Debug, Clone)]
 pub struct CurveNetwork {
     /// Welded curve vertices (with any inserted crossing points at the end).
@@ -101,6 +104,9 @@ pub struct NetworkStats {
     /// Crossings without a shared vertex given one: new points, and existing vertices used.
     pub crossings_inserted: usize,
     pub crossings_at_vertices: usize,
+    /// Crossings left unjoined because the aligned template has the two curves on two sheets
+    /// that pass through each other (a self-intersecting template; see `fit::sheets`).
+    pub crossings_on_two_sheets: usize,
     /// Largest gap closed by a junction or crossing (model units).
     pub junction_max_gap: f64,
     /// Curve ends left free (degree 1) after the junctions.
@@ -119,6 +125,13 @@ impl CurveNetwork {
     /// Builds the network from the polylines of `curves` (`Mesh::curves`). Faces of the curves
     /// input are ignored.
     pub fn build(curves: &Mesh, opt: &NetworkOptions) -> Result<Self> {
+        Self::build_checked(curves, opt, &|_, _| true)
+    }
+
+    /// [`CurveNetwork::build`] joining two crossing segments `a`, `b` only where `may_join(a, b)`
+    /// (the fit asks its aligned template: [`crate::fit::sheets`]); refusals are counted in
+    /// `crossings_on_two_sheets`.
+    pub fn build_checked(curves: &Mesh, opt: &NetworkOptions, may_join: &MayJoin<'_>) -> Result<Self> {
         if curves.curves.is_empty() {
             return Err(Error::params(
                 "curves",
@@ -191,7 +204,7 @@ impl CurveNetwork {
         if opt.junction_tolerance > 0.0 {
             b.merge_overlaps();
             b.join_ends(opt.junction_tolerance);
-            b.insert_crossings(opt.junction_tolerance);
+            b.insert_crossings(opt.junction_tolerance, may_join);
         }
         Ok(b.finish(&polyline_input))
     }

@@ -1,0 +1,50 @@
+//! Curves on two sheets of a self-intersecting template (`fit::sheets`). The shared cow passes
+//! through itself; its plane sections (of the repaired cow, scaled into the unit box) include
+//! curves on the two sheets that cross in space without meeting on the surface. Fitted with the
+//! raw cow itself as the template (no alignment), every section lies on the template: the truth
+//! is that every segment can be an edge chain and no face needs to turn. Joining those crossings
+//! (as the network build did) tied the sheets together: 2 segments unrealised, 64 flipped faces.
+
+use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
+use meshwork_core::fit::testdata::{plane_sections, sweep_planes, to_unit_box};
+use meshwork_core::fit::{run, Alignment, FitParams};
+use meshwork_core::geometry::Aabb;
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::mesh::Mesh;
+use meshwork_core::repair::{self, RepairParams};
+use meshwork_core::Progress;
+
+/// (the raw cow in the unit-box frame of the repaired cow, the repaired cow's plane sections).
+fn cow_and_sections() -> (Mesh, Mesh) {
+    let path = format!("{}/../../shared/meshes/cow.obj", env!("CARGO_MANIFEST_DIR"));
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
+    let params = RepairParams { fill_holes: false, ..Default::default() };
+    let mut fixed = repair::run(raw.clone(), &params, &Progress::new()).expect("repair").meshes.remove(0);
+    let bb = Aabb::of(&fixed.positions).expect("vertices");
+    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+    let mut raw_unit = raw;
+    for p in &mut raw_unit.positions {
+        for k in 0..3 {
+            p[k] = (p[k] - bb.min[k]) / side;
+        }
+    }
+    to_unit_box(&mut fixed);
+    let curves = plane_sections(&fixed, &sweep_planes(&fixed));
+    (raw_unit, curves)
+}
+
+#[test]
+fn crossings_on_two_sheets_of_the_cow_are_not_joined() {
+    let (cow, curves) = cow_and_sections();
+    // The network alone joins them (no template to ask).
+    let joined = CurveNetwork::build(&curves, &NetworkOptions::default()).expect("network").stats;
+    assert!(joined.crossings_inserted >= 4, "{joined:?}");
+    let params = FitParams { alignment: Alignment::None, ..Default::default() };
+    let out = run(vec![cow, curves], &params, &Progress::new()).expect("fit");
+    let r = &out.report;
+    let refused = r["network"]["crossings_on_two_sheets"].as_u64().expect("counted");
+    assert!(refused >= 4, "{}", r["network"]);
+    assert_eq!(r["segments_as_edges"], 1.0, "{}", r["retriangulation"]);
+    assert_eq!(r["flipped_faces"], 0, "{}", r["network"]);
+}
