@@ -412,12 +412,35 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     } else {
         None
     };
-    // Zero-area faces have no normal, so every fold test above passes them: flipped away where
-    // possible, counted in the report otherwise (`degenerate.after`).
+    // Zero-area faces have no normal, so every fold test above passes them: flipped or collapsed
+    // away where possible, counted and named in the report otherwise (`degenerate.after`, `left`).
     mesh.pos.clone_from(&out_pos);
-    let degenerate =
-        stages.run(progress, "degenerate", || Ok(degenerate::remove_zero_area(&mut mesh, &curve_edges)))?;
-    if degenerate.flips > 0 {
+    let degenerate = stages.run(progress, "degenerate", || {
+        // Curve points and boundary vertices never move; other chain vertices only along their chain.
+        let mut never_moved = boundary.clone();
+        for &v in &fine.vertex_of_point {
+            never_moved[v as usize] = true;
+        }
+        Ok(degenerate::remove_zero_area(
+            &mut mesh,
+            &mut degenerate::Constraints {
+                fixed: &never_moved,
+                on_chain: &realised.on_curve,
+                curve_edges: &mut curve_edges,
+            },
+        ))
+    })?;
+    if !degenerate.removed_vertices.is_empty() {
+        // A collapsed chain vertex leaves its chain (its neighbours were joined by the collapse).
+        let mut gone = vec![false; mesh.pos.len()];
+        for &v in &degenerate.removed_vertices {
+            gone[v as usize] = true;
+        }
+        for c in realised.chains.iter_mut() {
+            c.retain(|&v| !gone[v as usize]);
+        }
+    }
+    if degenerate.flips + degenerate.collapses > 0 {
         out_tris = mesh.live_triangles();
         (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
         if keep_groups {
@@ -427,7 +450,9 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
     // Vertices removed by the clean-up leave the output; every per-vertex array is renumbered.
-    let keep = compact::Renumber::new(out_pos.len(), &cleaned.removed_vertices);
+    let removed: Vec<u32> =
+        cleaned.removed_vertices.iter().chain(&degenerate.removed_vertices).copied().collect();
+    let keep = compact::Renumber::new(out_pos.len(), &removed);
     let out_tris: Vec<[u32; 3]> = out_tris.iter().map(|&t| keep.tri(t)).collect();
     for c in realised.chains.iter_mut() {
         keep.apply(c);
