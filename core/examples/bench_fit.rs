@@ -12,6 +12,9 @@
 
 use std::time::Instant;
 
+mod bench_support;
+use bench_support::process_cpu;
+
 use meshwork_core::fit::rbf::{Kernel, Rbf};
 use meshwork_core::fit::testdata::{bend, crossing_pairs, plane_sections, thin_network};
 use meshwork_core::fit::{run, FitParams};
@@ -502,20 +505,6 @@ fn main() {
     println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
     let c = case(&homer, 2, 1, true, false);
     rbf_peer(&c);
-}
-
-/// CPU time of all threads of this process so far (0 where /proc cannot tell): under load the
-/// wall time mostly measures waiting for a core, this the work done.
-fn process_cpu() -> std::time::Duration {
-    let ns: u64 = std::fs::read_dir("/proc/self/task")
-        .map(|d| {
-            d.filter_map(|t| t.ok())
-                .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
-                .filter_map(|s| s.split_whitespace().next().and_then(|v| v.parse::<u64>().ok()))
-                .sum()
-        })
-        .unwrap_or(0);
-    std::time::Duration::from_nanos(ns)
 }
 
 /// `--stage-cpu [RUNS]`: the headline with smoothing, run RUNS times, each with its wall time, its

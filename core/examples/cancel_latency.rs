@@ -17,6 +17,9 @@
 
 use std::time::{Duration, Instant};
 
+mod bench_support;
+use bench_support::process_cpu;
+
 use meshwork_core::fit::testdata::{bend, plane_sections};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::job::{run, JobKind};
@@ -28,19 +31,6 @@ fn load(name: &str) -> Mesh {
     let path = format!("../shared/meshes/{name}");
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     read(&bytes, &ReadOptions::default()).unwrap_or_else(|e| panic!("{path}: {e}")).mesh
-}
-
-/// CPU time of all threads of this process so far (0 where /proc cannot tell).
-fn process_cpu() -> Duration {
-    let ns: u64 = std::fs::read_dir("/proc/self/task")
-        .map(|d| {
-            d.filter_map(|t| t.ok())
-                .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
-                .filter_map(|s| s.split_whitespace().next().and_then(|v| v.parse::<u64>().ok()))
-                .sum()
-        })
-        .unwrap_or(0);
-    Duration::from_nanos(ns)
 }
 
 /// What one run gave: wall and CPU time from the cancel to the return (0 when the job ended

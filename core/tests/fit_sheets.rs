@@ -6,12 +6,10 @@
 //! (as the network build did) tied the sheets together: 2 segments unrealised, 64 flipped faces.
 
 use meshwork_core::fit::curves::{CurveNetwork, NetworkOptions};
-use meshwork_core::fit::testdata::{plane_sections, sweep_planes, to_unit_box};
+use meshwork_core::fit::testdata::sections_of_repaired;
 use meshwork_core::fit::{run, Alignment, FitParams};
-use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::Mesh;
-use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::Progress;
 
 /// (the raw cow in the unit-box frame of the repaired cow, the repaired cow's plane sections).
@@ -19,18 +17,7 @@ fn cow_and_sections() -> (Mesh, Mesh) {
     let path = format!("{}/../../shared/meshes/cow.obj", env!("CARGO_MANIFEST_DIR"));
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let raw = read(&bytes, &ReadOptions::default()).expect("read").mesh;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut fixed = repair::run(raw.clone(), &params, &Progress::new()).expect("repair").meshes.remove(0);
-    let bb = Aabb::of(&fixed.positions).expect("vertices");
-    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-    let mut raw_unit = raw;
-    for p in &mut raw_unit.positions {
-        for k in 0..3 {
-            p[k] = (p[k] - bb.min[k]) / side;
-        }
-    }
-    to_unit_box(&mut fixed);
-    let curves = plane_sections(&fixed, &sweep_planes(&fixed));
+    let (curves, raw_unit, _) = sections_of_repaired(raw).expect("repair");
     (raw_unit, curves)
 }
 

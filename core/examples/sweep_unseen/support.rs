@@ -5,9 +5,8 @@ pub use meshwork_core::fit::testdata::to_unit_box;
 use std::f64::consts::PI;
 
 use meshwork_core::fit::testdata::{
-    arc, circle, disjoint_union, ellipsoid_sections, plane_sections, section_regions, sweep_planes,
+    arc, circle, disjoint_union, ellipsoid_sections, sections_of_repaired, sweep_planes,
 };
-use meshwork_core::geometry::Aabb;
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::mesh::{Mesh, Point3};
 use meshwork_core::repair::{self, RepairParams};
@@ -118,20 +117,7 @@ pub fn icosphere_vs_sections_of(name: &str) -> Result<Vec<Mesh>, Error> {
 /// Plane sections of the repaired, unit-box copy of shared mesh `name`, and the unit-box raw mesh.
 pub fn sections_of(name: &str) -> (Mesh, Mesh, usize) {
     let raw = read_as(&shared(name), "x.obj").unwrap_or_default();
-    let mut fixed = repaired(raw.clone());
-    // The raw mesh in the same frame as the repaired one.
-    let bb = Aabb::of(&fixed.positions).expect("mesh has vertices");
-    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
-    let mut raw_unit = raw;
-    for p in &mut raw_unit.positions {
-        for k in 0..3 {
-            p[k] = (p[k] - bb.min[k]) / side;
-        }
-    }
-    to_unit_box(&mut fixed);
-    let planes = sweep_planes(&fixed);
-    let expected = section_regions(&fixed, &planes);
-    (plane_sections(&fixed, &planes), raw_unit, expected)
+    sections_of_repaired(raw).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 /// An icosphere of radius 0.5 centred at (0.5, 0.5, 0.5) squashed to 1 × 0.6 × `thick`.

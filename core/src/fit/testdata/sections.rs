@@ -321,3 +321,25 @@ pub fn sweep_planes(m: &Mesh) -> Vec<(Point3, f64)> {
     }
     p
 }
+
+/// A real mesh as the sweeps cut it: `raw` repaired (holes left open) and moved into the unit box,
+/// the sweep's planes cut through the repaired mesh, and the raw mesh carried into the same frame
+/// (scaled and shifted like the repaired one, its own defects kept). Returns (the sections, the
+/// raw mesh in that frame, the regions the planes cut the repaired surface into).
+pub fn sections_of_repaired(raw: Mesh) -> crate::error::Result<(Mesh, Mesh, usize)> {
+    let params = crate::repair::RepairParams { fill_holes: false, ..Default::default() };
+    let mut fixed = crate::repair::run(raw.clone(), &params, &crate::Progress::new())?.meshes.remove(0);
+    let bb = Aabb::of(&fixed.positions)
+        .ok_or_else(|| crate::error::Error::params("mesh", "the repaired mesh has no vertices"))?;
+    let side = (0..3).map(|k| bb.max[k] - bb.min[k]).fold(0.0, f64::max);
+    let mut raw_unit = raw;
+    for p in &mut raw_unit.positions {
+        for k in 0..3 {
+            p[k] = (p[k] - bb.min[k]) / side;
+        }
+    }
+    to_unit_box(&mut fixed);
+    let planes = sweep_planes(&fixed);
+    let expected = section_regions(&fixed, &planes);
+    Ok((plane_sections(&fixed, &planes), raw_unit, expected))
+}
