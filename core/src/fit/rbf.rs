@@ -6,9 +6,11 @@
 //! the data and reproduces affine functions).
 //!
 //! The system (2.8) has φ(0) = 0 on the diagonal and a 4×4 zero block: it is symmetric
-//! **indefinite** (the thesis's "positive definite" is wrong), so it is solved with a pivoted
-//! LBLᵀ, never Cholesky. It is singular for duplicate centres and for fewer than 4 non-coplanar
-//! ones; both are rejected before the solve with a message naming the centres. Coplanar centres
+//! **indefinite** (the thesis's "positive definite" is wrong), so no Cholesky of the whole system.
+//! It is definite on the null space of the polynomial block (φ = r is conditionally negative
+//! definite): [`super::cpd_solve`] factors it there with a Cholesky, and a pivoted LBLᵀ of the
+//! whole system is the fallback. It is singular for duplicate centres and for fewer than 4
+//! non-coplanar ones; both are rejected before the solve with a message naming the centres. Coplanar centres
 //! can instead be fitted with the polynomial part restricted to their plane
 //! ([`Rbf::fit_in_plane`]).
 
@@ -44,6 +46,15 @@ impl Kernel {
         match self {
             Kernel::Linear => r,
             Kernel::Cubic => r * r * r,
+        }
+    }
+
+    /// s with s·wᵀΦw > 0 for weights orthogonal to the affine functions: r is conditionally
+    /// negative definite (order 1), r³ conditionally positive definite (order 2).
+    fn definiteness_sign(self) -> f64 {
+        match self {
+            Kernel::Linear => -1.0,
+            Kernel::Cubic => 1.0,
         }
     }
 }
@@ -141,6 +152,40 @@ pub fn spread_ratios(points: &[Point3]) -> [f64; 2] {
     [(vals[0].max(0.0) / max).sqrt(), (vals[1].max(0.0) / max).sqrt()]
 }
 
+/// The interpolation system's matrix `[Φ P; Pᵀ 0]` for normalised centres `q`: Φ_ij = φ(|q_i −
+/// q_j|), P's rows (d · q_i for each direction, 1). Filled a column at a time, the columns in
+/// parallel: faer's matrices are column-major, and the row-by-row fill writing both (i, j) and
+/// (j, i) took ~46 ms at the headline's 2,156 centres (this one 27–31 ms with the system's right
+/// side, at load ~5; the rest is the first touch of 37 MB). Φ is still bitwise symmetric:
+/// |q_i − q_j| and |q_j − q_i| square the same differences up to sign.
+fn system_matrix(q: &[Point3], kernel: Kernel, directions: &[Point3]) -> Mat<f64> {
+    use rayon::prelude::*;
+    let (n, nd) = (q.len(), directions.len());
+    let m = n + nd + 1;
+    let mut a = Mat::<f64>::zeros(m, m);
+    a.as_mut().par_col_iter_mut().enumerate().for_each(|(j, mut col)| {
+        if j < n {
+            for (i, qi) in q.iter().enumerate() {
+                col[i] = if i == j { kernel.phi(0.0) } else { kernel.phi(dist(*qi, q[j])) };
+            }
+            for (k, d) in directions.iter().enumerate() {
+                col[n + k] = crate::geometry::dot(*d, q[j]);
+            }
+            col[n + nd] = 1.0;
+        } else if j < n + nd {
+            let d = directions[j - n];
+            for (i, qi) in q.iter().enumerate() {
+                col[i] = crate::geometry::dot(d, *qi);
+            }
+        } else {
+            for i in 0..n {
+                col[i] = 1.0;
+            }
+        }
+    });
+    a
+}
+
 impl Rbf {
     /// Solves for the field taking value `values[i]` at `centres[i]`. `stage` names the caller in
     /// errors. Call [`check_centres`] first for a message that names the offending centres; this
@@ -231,34 +276,21 @@ impl Rbf {
             .collect();
         let nd = directions.len();
         let m = n + nd + 1;
-        let mut a = Mat::<f64>::zeros(m, m);
-        for i in 0..n {
-            // Symmetric (|q_i − q_j| is bitwise |q_j − q_i|): each distance computed once.
-            for j in 0..i {
-                let v = kernel.phi(dist(q[i], q[j]));
-                a[(i, j)] = v;
-                a[(j, i)] = v;
-            }
-            a[(i, i)] = kernel.phi(0.0);
-            for (k, d) in directions.iter().enumerate() {
-                let x = crate::geometry::dot(*d, q[i]);
-                a[(i, n + k)] = x;
-                a[(n + k, i)] = x;
-            }
-            a[(i, n + nd)] = 1.0;
-            a[(n + nd, i)] = 1.0;
-        }
+        let a = system_matrix(&q, kernel, directions);
         let mut rhs = Mat::<f64>::zeros(m, 3);
         for i in 0..n {
             for k in 0..3 {
                 rhs[(i, k)] = values[i][k];
             }
         }
-        let x = if n >= INTERRUPTIBLE_CENTRES {
-            interruptible(progress, move || symmetric_solve(a, rhs))??
-        } else {
-            symmetric_solve(a, rhs)?
+        let (q_copy, dirs) = (q.clone(), directions.to_vec());
+        let solve = move || match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign()) {
+            Some(x) => Ok(x),
+            // Not numerically definite on the null space: the pivoted indefinite solve of the
+            // whole system (the matrix was used up, so it is built again).
+            None => symmetric_solve(system_matrix(&q_copy, kernel, &dirs), rhs),
         };
+        let x = if n >= INTERRUPTIBLE_CENTRES { interruptible(progress, solve)?? } else { solve()? };
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
         // The polynomial part as the rows x, y, z, 1 of a full affine map (Σ_k d_k ⊗ coefficient_k).
         let mut affine = [[0.0; 3]; 4];
@@ -451,14 +483,15 @@ impl Rbf {
 }
 
 /// From this many centres on, the dense factorisation runs on a worker thread while the job
-/// polls for a cancel ([`interruptible`]): faer's Bunch–Kaufman cannot be interrupted, and at the
-/// headline's ~2,000 centres it takes ~100–200 ms (the fit's worst cancel overshoot, measured by
+/// polls for a cancel ([`interruptible`]): faer's factorisations cannot be interrupted, and at the
+/// headline's ~2,000 centres they take ~50–200 ms (the fit's worst cancel overshoot, measured by
 /// `cancel_latency 8 fit`). On a cancel the factorisation finishes in the background on its own
 /// copy and is dropped. Below this (≤ 8 ms at load 1) the thread is not worth starting.
 pub const INTERRUPTIBLE_CENTRES: usize = 500;
 
 /// Dense symmetric-indefinite solve: Bunch–Kaufman LBLᵀ (half the flops of LU, pivoted, so the
-/// zero diagonal and zero affine block are fine), sequential (faer's parallel mode is never used).
+/// zero diagonal and zero affine block are fine), sequential. The fallback of the null-space
+/// Cholesky ([`super::cpd_solve`]) when the system is not numerically definite there.
 fn symmetric_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
     use faer::linalg::cholesky::lblt::{factor as bk, solve as bks};
     let n = a.nrows();
