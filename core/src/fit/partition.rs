@@ -34,6 +34,15 @@ pub fn regions_polled(
 ) -> Result<(Vec<u32>, usize)> {
     let nv = tris.iter().flatten().max().map_or(0, |&v| v as usize + 1);
     let vertex_faces = Csr::vertex_triangles(nv, tris);
+    // Only an edge with both ends on curve edges can be one: most edges skip the hash lookup.
+    let mut on_curve = vec![false; nv];
+    for &(a, b) in curve_edges {
+        for v in [a, b] {
+            if let Some(x) = on_curve.get_mut(v as usize) {
+                *x = true;
+            }
+        }
+    }
     let mut region = vec![u32::MAX; tris.len()];
     let mut count = 0u32;
     let mut stack = Vec::new();
@@ -53,7 +62,8 @@ pub fn regions_polled(
             let t = tris[f as usize];
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                if curve_edges.contains(&(a.min(b), a.max(b))) {
+                if on_curve[a as usize] && on_curve[b as usize] && curve_edges.contains(&(a.min(b), a.max(b)))
+                {
                     continue;
                 }
                 for g in vertex_faces.triangles_on_edge(tris, a, b) {

@@ -121,16 +121,19 @@ pub fn smooth(
     let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
     // Stage 1: modified mean-curvature flow.
+    // The positions being smoothed, replaced by each step's result (no copy per step); `pos`
+    // gets them at the end.
+    let mut cur = pos.to_vec();
     for it in 0..s.mcf_iterations {
         progress.fraction(it as f64 / total)?;
-        let old = pos.to_vec();
+        let old = &cur;
         // One pass over the faces at the old positions: cotangent weights and centroids (the
         // normals are in `shape`, kept up to date by the guard), computed once per face instead
         // of at each corner; then one pass over the vertices.
         let per_face: Vec<([f64; 3], Point3)> = tris
             .par_iter()
             .with_min_len(4096)
-            .map(|&t| (cotangent_weights(&old, t), centroid(&old, t)))
+            .map(|&t| (cotangent_weights(old, t), centroid(old, t)))
             .collect();
         let proposed: Vec<Point3> = (0..nv)
             .into_par_iter()
@@ -139,7 +142,7 @@ pub fn smooth(
                 if fixed[v] {
                     return old[v];
                 }
-                let acc = cotangent_sum(v, &old, tris, &r, &per_face);
+                let acc = cotangent_sum(v, old, tris, &r, &per_face);
                 if acc[3] <= 0.0 {
                     return old[v];
                 }
@@ -168,60 +171,58 @@ pub fn smooth(
             })
             .collect();
         // A halved step stays on the plane it was dropped onto (old and new are both on it).
-        commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q);
+        cur =
+            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q).0;
     }
     // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
-    let reference = pos.to_vec();
+    let reference = cur.clone();
     // Unit normals of the reference faces (the reference does not move in this stage).
     let ref_normals: Vec<Point3> =
         tris.par_iter().with_min_len(4096).map(|&t| normalize(face_normal(&reference, t))).collect();
     let mut ref_face: Vec<u32> = (0..nv).map(|v| r.vf.row(v).first().copied().unwrap_or(u32::MAX)).collect();
     for it in 0..s.laplacian_iterations {
         progress.fraction((s.mcf_iterations + it) as f64 / total)?;
-        let old = pos.to_vec();
-        let mut proposed = old.clone();
+        let old = &cur;
         let mut new_ref = ref_face.clone();
-        proposed.par_iter_mut().zip(new_ref.par_iter_mut()).enumerate().for_each(|(v, (p, rf))| {
-            let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
-            if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
-                return;
-            }
-            let mut m = [0.0; 3];
-            for &w in nbs {
-                m = add(m, old[w as usize]);
-            }
-            let m = scale(m, 1.0 / nbs.len() as f64);
-            let n = ref_normals[*rf as usize];
-            let d = sub(m, old[v]);
-            let moved = add(old[v], sub(d, scale(n, dot(d, n))));
-            let (f, q) = closest_by_walk(&reference, tris, &r, *rf, moved);
-            *rf = f;
-            *p = q;
-        });
+        let proposed: Vec<Point3> = new_ref
+            .par_iter_mut()
+            .enumerate()
+            .map(|(v, rf)| {
+                let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
+                if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
+                    return old[v];
+                }
+                let mut m = [0.0; 3];
+                for &w in nbs {
+                    m = add(m, old[w as usize]);
+                }
+                let m = scale(m, 1.0 / nbs.len() as f64);
+                let n = ref_normals[*rf as usize];
+                let d = sub(m, old[v]);
+                let moved = add(old[v], sub(d, scale(n, dot(d, n))));
+                let (f, q) = closest_by_walk(&reference, tris, &r, *rf, moved);
+                *rf = f;
+                q
+            })
+            .collect();
         // A halved step is dropped back onto the reference surface like a full one.
-        let kept = commit_safely(
-            pos,
-            &old,
-            proposed,
-            tris,
-            &r,
-            q_floor,
-            &mut shape,
-            &mut scratch,
-            &mut stats,
-            |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1,
-        );
+        let (next, kept) =
+            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |v, q| {
+                closest_by_walk(&reference, tris, &r, ref_face[v], q).1
+            });
         for v in kept {
-            let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], pos[v as usize]);
+            let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], next[v as usize]);
             new_ref[v as usize] = f;
         }
         for (v, rf) in ref_face.iter_mut().enumerate() {
-            if pos[v] == old[v] {
+            if next[v] == old[v] {
                 continue; // did not move: keep its face
             }
             *rf = new_ref[v];
         }
+        cur = next;
     }
+    pos.copy_from_slice(&cur);
     Ok(stats)
 }
 
@@ -370,11 +371,10 @@ fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
 }
 
 #[allow(clippy::too_many_arguments)]
-/// Moves `pos` from `old` to `proposed` where that is safe (see the module doc); `reproject`
-/// puts a halved step back on the surface. Returns the vertices whose step was halved and kept
-/// (their reference face may need updating).
+/// The positions reached from `old` towards `proposed` where that is safe (see the module doc);
+/// `reproject` puts a halved step back on the surface. Also returns the vertices whose step was
+/// halved and kept (their reference face may need updating).
 fn commit_safely(
-    pos: &mut [Point3],
     old: &[Point3],
     proposed: Vec<Point3>,
     tris: &[[u32; 3]],
@@ -384,14 +384,13 @@ fn commit_safely(
     new_shape: &mut Vec<(Point3, f64)>,
     stats: &mut SmoothStats,
     reproject: impl Fn(usize, Point3) -> Point3 + Sync,
-) -> Vec<u32> {
+) -> (Vec<Point3>, Vec<u32>) {
     let nv = old.len();
     let mut cand = proposed;
     let moves = cand.par_iter().zip(old).with_min_len(4096).filter(|(a, b)| a != b).count();
     stats.moves += moves;
     if moves == 0 {
-        pos.copy_from_slice(old);
-        return Vec::new();
+        return (cand, Vec::new());
     }
     // A relative margin so that the reported angle, computed differently, cannot come out lower.
     let floor = q_floor * (1.0 + 1e-9);
@@ -468,8 +467,7 @@ fn commit_safely(
             halved.push(v as u32);
         }
     }
-    pos.copy_from_slice(&cand);
-    halved
+    (cand, halved)
 }
 
 fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
