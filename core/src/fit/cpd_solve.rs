@@ -64,7 +64,7 @@ pub fn solve(mut a: Mat<f64>, rhs: &Mat<f64>, n: usize, sign: f64) -> Option<Mat
     });
     // Inside a rayon job (a sweep running fits in parallel) faer stays sequential: never nest.
     // Below a few hundred centres the factorisation takes a few ms and threads do not pay.
-    let par = if rayon::current_thread_index().is_some() || n < 512 { Par::Seq } else { Par::rayon(0) };
+    let par = if rayon::current_thread_index().is_some() || n < 500 { Par::Seq } else { Par::rayon(0) };
     let mut buf = MemBuffer::new(llt::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
     llt::cholesky_in_place(m.as_mut(), Default::default(), par, MemStack::new(&mut buf), Default::default())
         .ok()?;

@@ -284,11 +284,16 @@ impl Rbf {
             }
         }
         let (q_copy, dirs) = (q.clone(), directions.to_vec());
-        let solve = move || match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign()) {
-            Some(x) => Ok(x),
-            // Not numerically definite on the null space: the pivoted indefinite solve of the
-            // whole system (the matrix was used up, so it is built again).
-            None => symmetric_solve(system_matrix(&q_copy, kernel, &dirs), rhs),
+        let solve = move || {
+            if n < CHOLESKY_CENTRES {
+                return symmetric_solve(a, rhs);
+            }
+            match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign()) {
+                Some(x) => Ok(x),
+                // Not numerically definite on the null space: the pivoted indefinite solve of the
+                // whole system (the matrix was used up, so it is built again).
+                None => symmetric_solve(system_matrix(&q_copy, kernel, &dirs), rhs),
+            }
         };
         let x = if n >= INTERRUPTIBLE_CENTRES { interruptible(progress, solve)?? } else { solve()? };
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
@@ -481,6 +486,14 @@ impl Rbf {
         Ok(out)
     }
 }
+
+/// From this many centres on, the system is solved by the null-space Cholesky
+/// ([`super::cpd_solve`]); below, by the pivoted LBLᵀ of the whole system. Small systems (the
+/// coarse alignment, the approach levels) take a few ms either way, and keeping their solve keeps
+/// their round-off: with the Cholesky everywhere, one sweep case (icosphere vs sections of spot,
+/// automatic pose, flagged ambiguous) went from 0 to 5 flipped faces (docs/benchmarks.md,
+/// session 11).
+pub const CHOLESKY_CENTRES: usize = 500;
 
 /// From this many centres on, the dense factorisation runs on a worker thread while the job
 /// polls for a cancel ([`interruptible`]): faer's factorisations cannot be interrupted, and at the
