@@ -284,8 +284,9 @@ impl Rbf {
             }
         }
         let (q_copy, dirs) = (q.clone(), directions.to_vec());
+        let cholesky = n >= CHOLESKY_CENTRES && nd == 3 && spread_ratios(&q)[0] >= CHOLESKY_MIN_SPREAD;
         let solve = move || {
-            if n < CHOLESKY_CENTRES {
+            if !cholesky {
                 return symmetric_solve(a, rhs);
             }
             match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign()) {
@@ -494,6 +495,13 @@ impl Rbf {
 /// automatic pose, flagged ambiguous) went from 0 to 5 flipped faces (docs/benchmarks.md,
 /// session 11).
 pub const CHOLESKY_CENTRES: usize = 500;
+
+/// ... and only when the centres are spread in all three directions (the smallest principal
+/// spread at least this share of the largest). Nearly coplanar centre sets (thin shapes, planar
+/// networks) are where the fit is most sensitive to round-off: with the Cholesky, flat icosphere 4
+/// vs sections of the 1 × 0.6 × 0.04 ellipsoid (spread ratio ~0.05) went from 14 to 51 flipped
+/// faces. The headline's centres (homer's sections) are far above it.
+pub const CHOLESKY_MIN_SPREAD: f64 = 0.2;
 
 /// From this many centres on, the dense factorisation runs on a worker thread while the job
 /// polls for a cancel ([`interruptible`]): faer's factorisations cannot be interrupted, and at the
