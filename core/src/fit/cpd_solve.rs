@@ -26,17 +26,22 @@ use rayon::prelude::*;
 
 /// Solves the `m × m` system `a x = rhs` (rhs `m × 3`) whose first `n` rows and columns are Φ
 /// and whose last `m − n` columns of the first `n` rows are P (the lower-right block is 0 and the
-/// last `m − n` rows of rhs are 0). `sign` is s: −1 for φ(r) = r, +1 for φ(r) = r³. None when P
-/// is rank-deficient or M is not numerically positive definite; `a` is used up either way.
-pub fn solve(mut a: Mat<f64>, rhs: &Mat<f64>, n: usize, sign: f64) -> Option<Mat<f64>> {
+/// last `m − n` rows of rhs are 0). `sign` is s: −1 for φ(r) = r, +1 for φ(r) = r³; `par` is
+/// faer's parallelism for the factorisation (see [`parallelism`]). None when P is rank-deficient
+/// or M is not numerically positive definite; `a` is used up either way.
+pub fn solve(mut a: Mat<f64>, rhs: &Mat<f64>, n: usize, sign: f64, par: Par) -> Option<Mat<f64>> {
     let p = a.nrows() - n;
     let columns: Vec<Vec<f64>> = (0..p).map(|k| (0..n).map(|i| a[(i, n + k)]).collect()).collect();
     let (y, r) = orthonormal_basis(columns)?;
+    // The column passes use rayon only when faer may: this may run on a thread that is no rayon
+    // worker while the pool's workers wait for it (see [`parallelism`]).
+    let parallel = matches!(par, Par::Rayon(_));
     // G = ΦY, S = YᵀΦY.
     let g: Vec<Vec<f64>> = {
         let phi = a.as_ref().submatrix(0, 0, n, n);
+        let row = |j: usize| -> Vec<f64> { y.iter().map(|yk| dot_col(phi.col(j), yk)).collect() };
         let rows: Vec<Vec<f64>> =
-            (0..n).into_par_iter().map(|j| y.iter().map(|yk| dot_col(phi.col(j), yk)).collect()).collect();
+            if parallel { (0..n).into_par_iter().map(row).collect() } else { (0..n).map(row).collect() };
         (0..p).map(|k| rows.iter().map(|row| row[k]).collect()).collect()
     };
     let s: Vec<Vec<f64>> = (0..p).map(|k| (0..p).map(|l| dot(&y[k], &g[l])).collect()).collect();
@@ -53,18 +58,11 @@ pub fn solve(mut a: Mat<f64>, rhs: &Mat<f64>, n: usize, sign: f64) -> Option<Mat
         })
         .collect();
     let mut m = a.as_mut().submatrix_mut(0, 0, n, n);
-    m.as_mut().par_col_iter_mut().enumerate().for_each(|(j, mut col)| {
-        for i in 0..n {
-            let mut v = sign * col[i];
-            for l in 0..p {
-                v += y[l][i] * k[l][j] + k[l][i] * y[l][j];
-            }
-            col[i] = v;
-        }
-    });
-    // Inside a rayon job (a sweep running fits in parallel) faer stays sequential: never nest.
-    // Below a few hundred centres the factorisation takes a few ms and threads do not pay.
-    let par = if rayon::current_thread_index().is_some() || n < 500 { Par::Seq } else { Par::rayon(0) };
+    if parallel {
+        m.as_mut().par_col_iter_mut().enumerate().for_each(|(j, col)| to_m_column(j, col, sign, &y, &k));
+    } else {
+        m.as_mut().col_iter_mut().enumerate().for_each(|(j, col)| to_m_column(j, col, sign, &y, &k));
+    }
     let mut buf = MemBuffer::new(llt::cholesky_in_place_scratch::<f64>(n, par, Default::default()));
     llt::cholesky_in_place(m.as_mut(), Default::default(), par, MemStack::new(&mut buf), Default::default())
         .ok()?;
@@ -100,6 +98,31 @@ pub fn solve(mut a: Mat<f64>, rhs: &Mat<f64>, n: usize, sign: f64) -> Option<Mat
         }
     }
     Some(x)
+}
+
+/// Column j of Φ made column j of M = s·Φ + YKᵀ + KYᵀ, in place.
+fn to_m_column(j: usize, mut col: faer::ColMut<'_, f64>, sign: f64, y: &[Vec<f64>], k: &[Vec<f64>]) {
+    for i in 0..col.nrows() {
+        let mut v = sign * col[i];
+        for (yl, kl) in y.iter().zip(k) {
+            v += yl[i] * kl[j] + kl[i] * yl[j];
+        }
+        col[i] = v;
+    }
+}
+
+/// faer's parallelism for a factorisation of `n` unknowns requested from the current thread:
+/// sequential inside a rayon job (never nest: a fit run by rayon workers that all wait for their
+/// factorisation thread would leave faer's tasks in the global pool with no worker to run them)
+/// and below a few hundred unknowns (a few ms, threads do not pay); faer's rayon mode otherwise.
+/// Call it on the job's thread, not on the thread the factorisation then runs on (that one is
+/// never a rayon worker).
+pub fn parallelism(n: usize) -> Par {
+    if rayon::current_thread_index().is_some() || n < 500 {
+        Par::Seq
+    } else {
+        Par::rayon(0)
+    }
 }
 
 /// Y with orthonormal columns and upper-triangular R with `columns = Y R` (modified Gram–Schmidt,
@@ -197,7 +220,7 @@ mod tests {
         let q = centres(300);
         for (cubic, sign) in [(false, -1.0), (true, 1.0)] {
             let (a, rhs) = system(&q, cubic);
-            let x = solve(a.clone(), &rhs, q.len(), sign).expect("definite on the null space");
+            let x = solve(a.clone(), &rhs, q.len(), sign, Par::Seq).expect("definite on the null space");
             // Every equation, including the side conditions Pᵀw = 0 (the last four rows).
             let r = residual(&a, &x, &rhs);
             assert!(r < 1e-9, "cubic {cubic}: residual {r:e}");
@@ -209,10 +232,10 @@ mod tests {
         let q = centres(120);
         // φ(r) = r with s = +1: M is indefinite, the Cholesky stops.
         let (a, rhs) = system(&q, false);
-        assert!(solve(a, &rhs, q.len(), 1.0).is_none());
+        assert!(solve(a, &rhs, q.len(), 1.0, Par::Seq).is_none());
         // All centres on the plane z = 0: the column of z is 0, P has rank 3.
         let flat: Vec<Point3> = q.iter().map(|p| [p[0], p[1], 0.0]).collect();
         let (a, rhs) = system(&flat, false);
-        assert!(solve(a, &rhs, flat.len(), -1.0).is_none());
+        assert!(solve(a, &rhs, flat.len(), -1.0, Par::Seq).is_none());
     }
 }

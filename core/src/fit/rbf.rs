@@ -159,7 +159,6 @@ pub fn spread_ratios(points: &[Point3]) -> [f64; 2] {
 /// side, at load ~5; the rest is the first touch of 37 MB). Φ is still bitwise symmetric:
 /// |q_i − q_j| and |q_j − q_i| square the same differences up to sign.
 fn system_matrix(q: &[Point3], kernel: Kernel, directions: &[Point3]) -> Mat<f64> {
-    use rayon::prelude::*;
     let (n, nd) = (q.len(), directions.len());
     let m = n + nd + 1;
     let mut a = Mat::<f64>::zeros(m, m);
@@ -285,11 +284,13 @@ impl Rbf {
         }
         let (q_copy, dirs) = (q.clone(), directions.to_vec());
         let cholesky = n >= CHOLESKY_CENTRES && nd == 3 && spread_ratios(&q)[0] >= CHOLESKY_MIN_SPREAD;
+        // Decided here, on the job's thread: the solve may run on a thread of its own.
+        let par = super::cpd_solve::parallelism(n);
         let solve = move || {
             if !cholesky {
                 return symmetric_solve(a, rhs);
             }
-            match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign()) {
+            match super::cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign(), par) {
                 Some(x) => Ok(x),
                 // Not numerically definite on the null space: the pivoted indefinite solve of the
                 // whole system (the matrix was used up, so it is built again).
@@ -655,6 +656,21 @@ mod tests {
             .collect();
         let v = c.iter().map(|p| [0.1 * p[1], 0.05 * p[0] * p[2], -0.02 * p[2] * p[2]]).collect();
         (c, v)
+    }
+
+    #[test]
+    fn fits_run_by_every_worker_of_the_global_pool_finish() {
+        // Each worker waits (not as a rayon task) for its factorisation thread. Had that thread
+        // asked the same pool for faer's tasks, no worker would be free to run them: a hang.
+        let (c, v) = sphere_data(800);
+        assert!(c.len() >= CHOLESKY_CENTRES && spread_ratios(&c)[0] >= CHOLESKY_MIN_SPREAD);
+        let n = rayon::current_num_threads();
+        let ok = (0..n)
+            .into_par_iter()
+            .map(|_| Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &Progress::new()).is_ok())
+            .filter(|&ok| ok)
+            .count();
+        assert_eq!(ok, n);
     }
 
     #[test]
