@@ -23,7 +23,6 @@ pub mod cleanup;
 mod coarse;
 pub mod compact;
 pub mod correspond;
-mod cpd_solve;
 pub mod curves;
 pub mod degenerate;
 pub mod ends;
