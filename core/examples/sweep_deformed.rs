@@ -108,6 +108,15 @@ fn main() {
                             .iter()
                             .map(|&q| bvh.closest(q).map_or(0.0, |h| h.dist2.sqrt()))
                             .fold(0.0, f64::max);
+                        if std::env::var("SWEEP_DETAIL").is_ok() {
+                            eprintln!(
+                                "  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",
+                                r["untangle"], r["cleanup"], r["retriangulation"], r["folds"]
+                            );
+                        }
+                        if std::env::var("SWEEP_FOLDS").is_ok() {
+                            print_folds(m);
+                        }
                         let ok = r["flipped_faces"] == 0 && r["segments_as_edges"] == 1.0;
                         println!(
                             "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {}",
@@ -122,6 +131,45 @@ fn main() {
                         );
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Diagnostic (`SWEEP_FOLDS=1`): every pair of faces on an edge whose normals are over 150°
+/// apart, with their corners, which of them are on output curve chains, and the positions.
+fn print_folds(m: &meshwork_core::mesh::Mesh) {
+    use std::collections::HashMap;
+    let tris = m.faces.triangles();
+    let on_curve: std::collections::HashSet<u32> = m.curves.iter().flatten().copied().collect();
+    let mut by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let n = |f: usize| {
+        let t = tris[f];
+        triangle_cross(m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize])
+    };
+    for (e, fs) in &by_edge {
+        if fs.len() != 2 {
+            continue;
+        }
+        let (a, b) = (n(fs[0]), n(fs[1]));
+        let c = dot(a, b) / (dot(a, a) * dot(b, b)).sqrt();
+        if c < (150f64).to_radians().cos() {
+            let mark = |v: u32| format!("{v}{}", if on_curve.contains(&v) { "*" } else { "" });
+            eprintln!(
+                "  fold edge {e:?} cos {c:.6} faces {:?} {:?} / {:?} {:?}",
+                fs[0],
+                tris[fs[0]].map(mark),
+                fs[1],
+                tris[fs[1]].map(mark)
+            );
+            for v in tris[fs[0]].iter().chain(&tris[fs[1]]) {
+                eprintln!("    v{v} {:?}", m.positions[*v as usize]);
             }
         }
     }
