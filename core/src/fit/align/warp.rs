@@ -25,6 +25,21 @@ pub struct WarpReport {
     pub damped: u32,
 }
 
+/// Matches within this many curve segments (the median) of the surface are never trimmed.
+///
+/// Why: the trim is for curves running off the template, and its cut (2.5 × the median distance)
+/// shrinks with the fit. Where the template fits most curves closely, the cut fell below the
+/// distances that still carry the pose: on a flattened ellipsoid 1 × 0.6 × 0.04 (sweep_unseen) the
+/// sheets fit to ~3e-5, the cut was ~7.5e-5, and the curve points at the tips, 0.0025–0.003 off,
+/// were dropped; the template stayed 0.0037 too far along its long axis, its rim beyond the curves'
+/// rim by 5 × the rim's radius of curvature, and the fit folded the rim (14 flipped faces in the
+/// report, 100 against the analytic normal; with this floor 0 and 0). Measured there, floors of
+/// 1 / 1.25 / 1.5 / 2 / 3 segments: 5 / 0 / 0 / 3 / 3 flipped faces. Feet on faces touching an
+/// open boundary keep the plain cut: with the floor there, "curves past an open template's rim"
+/// (sweep_unseen) stretched the template over the curves instead of reporting them
+/// (docs/benchmarks.md, fit-thin, session 11).
+const TRIM_FLOOR_SEGMENTS: f64 = 1.25;
+
 /// Monomials of degree ≤ 2 of `u` (1, u, v, w, u², v², w², uv, vw, wu); `degree` 1 keeps 4.
 fn monomials(u: Point3, degree: usize) -> ([f64; 10], usize) {
     let m =
@@ -75,13 +90,16 @@ fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Option<Vec<[f64; 3]>> {
 /// with few parameters is stiff, so iterating closest points moves it tangentially too (the shape
 /// of the curve network pins it), which a sparse interpolating RBF cannot do.
 ///
-/// Guards: matches farther than 2.5× the median are trimmed; every coefficient is pulled towards
+/// Guards: matches farther than 2.5× the median distance are trimmed, unless within
+/// [`TRIM_FLOOR_SEGMENTS`] × `spacing` (the curves' median segment; 0 for no floor) on a face away
+/// from the template's open boundary; every coefficient is pulled towards
 /// zero by a ridge term, the quadratic ones harder, so directions the curves do not determine
 /// (all curves on one plane) stay put; a step that would fold faces is halved (then stops).
 pub fn warp_icp(
     pos: &mut [Point3],
     tris: &[[u32; 3]],
     points: &[Point3],
+    spacing: f64,
     iterations: u32,
     progress: &Progress,
 ) -> Result<WarpReport> {
@@ -98,11 +116,23 @@ pub fn warp_icp(
         return Ok(report);
     }
     let mut tracked = TrackedFeet::new(pos, tris, points, &which, progress)?;
+    // Faces touching the template's open boundary: a foot there may be a curve running off the
+    // template, which the trim is for, so the floor does not keep it.
+    let on_rim: Vec<bool> = {
+        let rim = super::super::trimesh::boundary_vertices(pos.len(), tris);
+        tris.iter().map(|t| t.iter().any(|&v| rim[v as usize])).collect()
+    };
     let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
         let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
         d.sort_by(f64::total_cmp);
         let cut = 2.5 * d[d.len() / 2];
-        let keep: Vec<usize> = (0..feet.len()).filter(|&i| feet[i].2 <= cut.max(1e-300)).collect();
+        let floor = TRIM_FLOOR_SEGMENTS * spacing;
+        let keep: Vec<usize> = (0..feet.len())
+            .filter(|&i| {
+                let f = feet[i];
+                f.2 <= cut.max(1e-300) || (f.2 <= floor && !on_rim[f.0 as usize])
+            })
+            .collect();
         let rms =
             (keep.iter().map(|&i| feet[i].2 * feet[i].2).sum::<f64>() / keep.len().max(1) as f64).sqrt();
         (keep, rms)
