@@ -7,8 +7,8 @@
 //! Run from the repository root (reads `../shared/meshes/homer.obj`) with a private release target dir
 //! (see docs/benchmarks.md → Fit: the shared one mixes worktrees' builds of this example):
 //! `CARGO_TARGET_DIR=/tmp/fit-rel cargo run --release -p meshwork-core --example bench_fit`
-//! (`--stage-cpu [RUNS]`: the headline with smoothing only, CPU time per stage and a digest of the
-//! output, for comparing two builds under load.)
+//! (`--stage-cpu [RUNS]`: the headline with smoothing only, CPU and wall time per stage and a
+//! digest of the output, for comparing two builds under load.)
 
 use std::time::Instant;
 
@@ -508,8 +508,9 @@ fn main() {
 }
 
 /// `--stage-cpu [RUNS]`: the headline with smoothing, run RUNS times, each with its wall time, its
-/// CPU time (all threads) per stage and in all, and a digest of the output (positions' bits,
-/// faces, groups, curves) so that two builds can be shown to give the same mesh. A stage's CPU
+/// CPU time (all threads) and wall time per stage (`cpu/wall`; wall near CPU is a serial stage),
+/// its CPU in all, and a digest of the output (positions' bits, faces, groups, curves) so that
+/// two builds can be shown to give the same mesh. A stage's CPU
 /// runs from its entry to the next stage's, so the unstaged work between two stages counts for
 /// the first (the listener sees stage entries and fractions only).
 fn stage_cpu(c: &Case, runs: usize) {
@@ -517,22 +518,28 @@ fn stage_cpu(c: &Case, runs: usize) {
     use std::sync::{Arc, Mutex};
     for _ in 0..runs {
         let progress = Progress::new();
-        let marks: Arc<Mutex<Vec<(String, std::time::Duration)>>> = Arc::default();
+        type Mark = (String, std::time::Duration, Instant);
+        let marks: Arc<Mutex<Vec<Mark>>> = Arc::default();
         let m = marks.clone();
         progress.set_listener(move |stage, _| {
             let mut m = m.lock().unwrap();
             if m.last().is_none_or(|l| l.0 != stage) {
-                m.push((stage.to_string(), process_cpu()));
+                m.push((stage.to_string(), process_cpu(), Instant::now()));
             }
         });
         let (t, cpu0) = (Instant::now(), process_cpu());
         let out = run(vec![c.template.clone(), c.curves.clone()], &c.params, &progress).expect("fit");
-        let (wall, cpu_end) = (t.elapsed().as_secs_f64(), process_cpu());
+        let (wall, cpu_end, end) = (t.elapsed().as_secs_f64(), process_cpu(), Instant::now());
         let marks = marks.lock().unwrap().clone();
         let mut per_stage = Vec::new();
-        for (i, (stage, at)) in marks.iter().enumerate() {
+        for (i, (stage, at, at_wall)) in marks.iter().enumerate() {
             let next = marks.get(i + 1).map_or(cpu_end, |m| m.1);
-            per_stage.push(format!("{stage} {:.0}", next.saturating_sub(*at).as_secs_f64() * 1e3));
+            let next_wall = marks.get(i + 1).map_or(end, |m| m.2);
+            per_stage.push(format!(
+                "{stage} {:.0}/{:.0}",
+                next.saturating_sub(*at).as_secs_f64() * 1e3,
+                (next_wall - *at_wall).as_secs_f64() * 1e3
+            ));
         }
         let mesh = &out.meshes[0];
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -545,7 +552,7 @@ fn stage_cpu(c: &Case, runs: usize) {
         mesh.curves.hash(&mut h);
         let r = &out.report;
         println!(
-            "wall {wall:.3} s cpu {:.3} s | edges {:.4} flipped {} regions {} V {} F {} digest {:016x} | cpu ms: {}",
+            "wall {wall:.3} s cpu {:.3} s | edges {:.4} flipped {} regions {} V {} F {} digest {:016x} | cpu/wall ms: {}",
             cpu_end.saturating_sub(cpu0).as_secs_f64(),
             r["segments_as_edges"].as_f64().unwrap_or(0.0),
             r["flipped_faces"],

@@ -182,12 +182,13 @@ fn long_passes_poll_in_proportion_to_their_work() {
 }
 
 /// The fit's `partition` (a flood fill over the re-triangulated faces, 200–290 ms of CPU without a
-/// poll on the 200k faces of `cancel_latency`) reports its fraction every 4,096 faces of each of its
-/// two passes: on a 5,120-face template cut into octants at least 2 polls per pass. The code before
-/// made none inside the stage.
+/// poll on the 200k faces of `cancel_latency` in session 9) reports its fraction every 4,096 faces
+/// of its fill: on a 5,120-face template cut into octants (~7,000 faces after the re-triangulation)
+/// at least 2 polls. The code before session 10 made none inside the stage. (Session 11: the
+/// edge → faces map pass, polled too then, became vertex → faces lists that take a few ms.)
 #[test]
 fn the_fit_partition_polls_inside() {
     let curves = ellipsoid_sections([1.4, 1.15, 0.9], 6);
     let (_, s) = polls(JobKind::Fit, &[icosphere(4, 1.0), curves], &json!({}));
-    assert!(stage_polls(&s, "partition") >= 2 + 2, "{s:?}");
+    assert!(stage_polls(&s, "partition") >= 2, "{s:?}");
 }

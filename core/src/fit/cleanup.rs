@@ -20,6 +20,7 @@
 //! - a collapse keeps the mesh manifold (link condition: x and y share exactly the two
 //!   neighbours opposite their edge).
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::Result;
@@ -183,20 +184,19 @@ pub fn clean(
     let mut stats = CleanupStats::default();
     let (n_bad, qmin) = census(mesh, q_bad, progress)?;
     stats.bad_faces_before = n_bad;
-    scan_faces(mesh, progress, |f| {
+    let cr: &Constraints = c;
+    stats.inherited_thin_faces = scan_faces(mesh, progress, |f| {
         let t = mesh.tris[f as usize];
         let q = face_q(mesh, t);
-        stats.inherited_thin_faces += (q < q_bad && q >= threshold(c, t, q_bad)) as usize;
-    })?;
+        (q < q_bad && q >= threshold(cr, t, q_bad)).then_some(())
+    })?
+    .len();
     stats.min_angle_deg_before = min_angle_deg(qmin);
     let mut removed = vec![false; mesh.pos.len()];
     for pass in 0..s.max_passes {
-        let mut bad: Vec<(f64, u32)> = Vec::new();
-        scan_faces(mesh, progress, |f| {
+        let mut bad: Vec<(f64, u32)> = scan_faces(mesh, progress, |f| {
             let q = face_q(mesh, mesh.tris[f as usize]);
-            if q < q_bad {
-                bad.push((q, f));
-            }
+            (q < q_bad).then_some((q, f))
         })?;
         if bad.is_empty() {
             break;
@@ -258,26 +258,34 @@ const POLL_FACES: usize = 16_384;
 /// Faces below the threshold tried (a flip or a collapse each) between two polls.
 const POLL_BAD_FACES: usize = 256;
 
-/// Calls `visit` on every live face id in order, polling every [`POLL_FACES`] ids.
-fn scan_faces(mesh: &TriMesh, progress: &Progress, mut visit: impl FnMut(u32)) -> Result<()> {
-    for f in 0..mesh.tris.len() {
-        progress.check_every(f, POLL_FACES)?;
-        if mesh.alive[f] {
-            visit(f as u32);
-        }
+/// `visit` of every live face id, the `Some`s in face order: [`POLL_FACES`] ids at a time, polling
+/// before each block, the ids of a block in parallel (the stage's ~12 scans of the headline's 200k
+/// faces were ~45 ms of serial CPU).
+fn scan_faces<T: Send>(
+    mesh: &TriMesh,
+    progress: &Progress,
+    visit: impl Fn(u32) -> Option<T> + Sync,
+) -> Result<Vec<T>> {
+    let mut out = Vec::new();
+    for start in (0..mesh.tris.len()).step_by(POLL_FACES) {
+        progress.check()?;
+        let end = (start + POLL_FACES).min(mesh.tris.len());
+        let block: Vec<T> = (start..end)
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&f| mesh.alive[f])
+            .filter_map(|f| visit(f as u32))
+            .collect();
+        out.extend(block);
     }
-    Ok(())
+    Ok(out)
 }
 
 /// (faces below the threshold, worst quality).
 fn census(mesh: &TriMesh, q_bad: f64, progress: &Progress) -> Result<(usize, f64)> {
-    let mut n = 0;
-    let mut qmin = f64::INFINITY;
-    scan_faces(mesh, progress, |f| {
-        let q = face_q(mesh, mesh.tris[f as usize]);
-        n += (q < q_bad) as usize;
-        qmin = qmin.min(q);
-    })?;
+    let q = scan_faces(mesh, progress, |f| Some(face_q(mesh, mesh.tris[f as usize])))?;
+    let n = q.iter().filter(|&&q| q < q_bad).count();
+    let qmin = q.iter().copied().fold(f64::INFINITY, f64::min);
     Ok((n, if qmin.is_finite() { qmin } else { 1.0 }))
 }
 

@@ -385,12 +385,8 @@ mod tests {
         let (s, _) = run(&mut m, &[0, 1], &[(0, 1)]);
         assert_eq!((s.before, s.flips, s.collapses, s.after), (1, 0, 0, 1));
         assert_eq!(s.left.len(), 1);
-        assert!(dist3(s.left[0].at, [1.0, 0.0, 0.0]) < 1e-12, "{:?}", s.left);
+        assert!(crate::geometry::dist(s.left[0].at, [1.0, 0.0, 0.0]) < 1e-12, "{:?}", s.left);
         assert_eq!((m.live_triangles(), m.pos), (tris, pos));
-    }
-
-    fn dist3(a: Point3, b: Point3) -> f64 {
-        norm(sub(a, b))
     }
 
     /// Square a(0,0) b(2,0) c(2,2) d(0,2) with v(1,1) and q 1e-12 to its right: the two faces on

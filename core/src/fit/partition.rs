@@ -4,9 +4,10 @@
 use std::collections::HashSet;
 use std::hash::BuildHasherDefault;
 
-use super::trimesh::{IntHasher, IntMap};
+use super::trimesh::IntHasher;
 use crate::error::Result;
 use crate::job::Progress;
+use crate::topology::Csr;
 
 /// Faces handled between two polls: ~5 ms of work in release on the headline's meshes (the whole
 /// stage, unpolled, took 200–290 ms of CPU on 200k faces; docs/benchmarks.md → Cancellation).
@@ -20,27 +21,25 @@ pub fn regions(
     Progress::unpolled(|p| regions_polled(tris, curve_edges, p))
 }
 
-/// [`regions`], reporting its fraction done (and so polling) every [`POLL_FACES`] faces of each
-/// of its two passes: the edge → faces map (the first half) and the flood fill (the second).
+/// [`regions`], reporting its fraction done (and so polling) every [`POLL_FACES`] faces labelled.
+///
+/// Faces meet across an edge when both contain its two ends: the fill looks them up in the
+/// vertex → faces lists (a counting sort), not in an edge → faces hash map, which cost ~118 ms of
+/// serial CPU on the headline's 200k faces (docs/benchmarks.md, session 11). All faces on a
+/// non-manifold edge are joined to each other.
 pub fn regions_polled(
     tris: &[[u32; 3]],
     curve_edges: &HashSet<(u32, u32), BuildHasherDefault<IntHasher>>,
     progress: &Progress,
 ) -> Result<(Vec<u32>, usize)> {
-    let half = |done: usize, pass: usize| 0.5 * (pass as f64 + done as f64 / tris.len().max(1) as f64);
-    let mut edge_faces: IntMap<(u32, u32), [u32; 2]> = IntMap::default();
-    edge_faces.reserve(tris.len() * 3 / 2);
-    for (f, t) in tris.iter().enumerate() {
-        if f % POLL_FACES == 0 {
-            progress.fraction(half(f, 0))?;
-        }
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let e = edge_faces.entry((a.min(b), a.max(b))).or_insert([u32::MAX; 2]);
-            if e[0] == u32::MAX {
-                e[0] = f as u32;
-            } else {
-                e[1] = f as u32;
+    let nv = tris.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+    let vertex_faces = Csr::vertex_triangles(nv, tris);
+    // Only an edge with both ends on curve edges can be one: most edges skip the hash lookup.
+    let mut on_curve = vec![false; nv];
+    for &(a, b) in curve_edges {
+        for v in [a, b] {
+            if let Some(x) = on_curve.get_mut(v as usize) {
+                *x = true;
             }
         }
     }
@@ -57,22 +56,20 @@ pub fn regions_polled(
         stack.push(seed as u32);
         while let Some(f) = stack.pop() {
             if labelled % POLL_FACES == 0 {
-                progress.fraction(half(labelled, 1))?;
+                progress.fraction(labelled as f64 / tris.len() as f64)?;
             }
             labelled += 1;
             let t = tris[f as usize];
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                if curve_edges.contains(&key) {
+                if on_curve[a as usize] && on_curve[b as usize] && curve_edges.contains(&(a.min(b), a.max(b)))
+                {
                     continue;
                 }
-                if let Some(e) = edge_faces.get(&key) {
-                    for &g in e {
-                        if g != u32::MAX && region[g as usize] == u32::MAX {
-                            region[g as usize] = count;
-                            stack.push(g);
-                        }
+                for g in vertex_faces.triangles_on_edge(tris, a, b) {
+                    if region[g as usize] == u32::MAX {
+                        region[g as usize] = count;
+                        stack.push(g);
                     }
                 }
             }
@@ -100,8 +97,8 @@ mod tests {
         assert_eq!(tris.len(), 81_920);
         let p = Progress::new();
         let (region, count) = regions_polled(&tris, &cut, &p).unwrap();
-        // 81,920 / 4096 = 20 polls in each of the two passes.
-        assert_eq!(p.checks(), 40);
+        // 81,920 / 4096 = 20 polls of the fill.
+        assert_eq!(p.checks(), 20);
         assert_eq!(count, 2);
         let first = region.iter().filter(|&&r| r == region[0]).count();
         assert_eq!(first, 80 * 512, "each half has 80 strips of 512 triangles");
@@ -110,5 +107,18 @@ mod tests {
         p.cancel_at_check(7);
         assert!(matches!(regions_polled(&tris, &cut, &p), Err(crate::error::Error::Cancelled)));
         assert_eq!(p.checks(), 7, "stopped at the cancel, not after the pass");
+    }
+
+    /// Three triangles on one edge (a fin) and a fourth beyond one of them, no curves: one region.
+    /// The edge → [first, last] face map before session 11 reached the middle fin face from the
+    /// others only one way, and the fill seeded at face 0 left it as a second region.
+    #[test]
+    fn all_faces_on_a_non_manifold_edge_are_one_region() {
+        let tris = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [1, 3, 5]];
+        let none = HashSet::default();
+        assert_eq!(regions(&tris, &none), (vec![0, 0, 0, 0], 1));
+        // The fin's edge as a curve edge separates all three, and the fourth goes with the second.
+        let cut: HashSet<(u32, u32), BuildHasherDefault<IntHasher>> = [(0, 1)].into_iter().collect();
+        assert_eq!(regions(&tris, &cut), (vec![0, 1, 2, 1], 3));
     }
 }

@@ -26,6 +26,7 @@ use crate::error::Result;
 use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
+use crate::topology::Csr;
 
 pub struct SmoothSettings {
     pub mcf_iterations: u32,
@@ -58,33 +59,17 @@ struct Rings {
     ff: Vec<[u32; 3]>,
     nb_off: Vec<u32>,
     nb: Vec<u32>,
-    vf_off: Vec<u32>,
-    vf: Vec<u32>,
+    /// Vertex → faces, each row in face order.
+    vf: Csr,
 }
 
 fn rings(nv: usize, tris: &[[u32; 3]]) -> Rings {
-    let mut vf_cnt = vec![0u32; nv + 1];
-    for t in tris {
-        for &v in t {
-            vf_cnt[v as usize + 1] += 1;
-        }
-    }
-    for i in 0..nv {
-        vf_cnt[i + 1] += vf_cnt[i];
-    }
-    let mut vf = vec![0u32; vf_cnt[nv] as usize];
-    let mut fill = vf_cnt.clone();
-    for (f, t) in tris.iter().enumerate() {
-        for &v in t {
-            vf[fill[v as usize] as usize] = f as u32;
-            fill[v as usize] += 1;
-        }
-    }
+    let vf = Csr::vertex_triangles(nv, tris);
     let mut nb_off = vec![0u32; nv + 1];
-    let mut nb = Vec::with_capacity(vf.len());
+    let mut nb = Vec::with_capacity(vf.items.len());
     for v in 0..nv {
         let start = nb.len();
-        for &f in &vf[vf_cnt[v] as usize..vf_cnt[v + 1] as usize] {
+        for &f in vf.row(v) {
             for &w in &tris[f as usize] {
                 if w as usize != v && !nb[start..].contains(&w) {
                     nb.push(w);
@@ -93,18 +78,25 @@ fn rings(nv: usize, tris: &[[u32; 3]]) -> Rings {
         }
         nb_off[v + 1] = nb.len() as u32;
     }
-    let mut half: super::trimesh::IntMap<(u32, u32), u32> = super::trimesh::IntMap::default();
-    half.reserve(tris.len() * 3);
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            half.insert((t[k], t[(k + 1) % 3]), f as u32);
-        }
-    }
-    let ff = tris
-        .iter()
-        .map(|t| std::array::from_fn(|k| *half.get(&(t[(k + 1) % 3], t[k])).unwrap_or(&u32::MAX)))
+    // The face across edge k of f uses that edge the other way round; with several (a
+    // non-manifold input), the last in face order, as a directed-edge map filled in face order
+    // would keep. Looked up in the ring of the edge's second end: no hash map (~60 ms of serial
+    // CPU on the headline's 200k faces).
+    let across = |f: usize, k: usize| {
+        let t = tris[f];
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        let ring = vf.row(b as usize);
+        ring.iter().rev().copied().find(|&g| {
+            let u = tris[g as usize];
+            (0..3).any(|j| u[j] == b && u[(j + 1) % 3] == a)
+        })
+    };
+    let ff = (0..tris.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|f| std::array::from_fn(|k| across(f, k).unwrap_or(u32::MAX)))
         .collect();
-    Rings { ff, nb_off, nb, vf_off: vf_cnt, vf }
+    Rings { ff, nb_off, nb, vf }
 }
 
 fn face_normal(pos: &[Point3], t: [u32; 3]) -> Point3 {
@@ -129,113 +121,158 @@ pub fn smooth(
     let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
     // Stage 1: modified mean-curvature flow.
+    // The positions being smoothed, replaced by each step's result (no copy per step); `pos`
+    // gets them at the end.
+    let mut cur = pos.to_vec();
     for it in 0..s.mcf_iterations {
         progress.fraction(it as f64 / total)?;
-        // Cotangent weights per vertex pair, accumulated face by face.
-        let mut acc = vec![[0.0f64; 4]; nv]; // Σ w·q (3) and Σ w
-        for t in tris {
-            for k in 0..3 {
-                let (i, j, o) = (t[k] as usize, t[(k + 1) % 3] as usize, t[(k + 2) % 3] as usize);
-                let (u, v) = (sub(pos[i], pos[o]), sub(pos[j], pos[o]));
-                let cr = norm2(cross(u, v)).sqrt();
-                if cr <= 0.0 {
-                    continue;
+        let old = &cur;
+        // One pass over the faces at the old positions: cotangent weights and centroids (the
+        // normals are in `shape`, kept up to date by the guard), computed once per face instead
+        // of at each corner; then one pass over the vertices.
+        let per_face: Vec<([f64; 3], Point3)> = tris
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&t| (cotangent_weights(old, t), centroid(old, t)))
+            .collect();
+        let proposed: Vec<Point3> = (0..nv)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map(|v| {
+                if fixed[v] {
+                    return old[v];
                 }
-                // Negative cotangents (obtuse corners) are clamped: they make the step leave the ring.
-                let w = (dot(u, v) / cr).max(0.0) * 0.5;
-                for (a, b) in [(i, j), (j, i)] {
-                    acc[a][0] += w * pos[b][0];
-                    acc[a][1] += w * pos[b][1];
-                    acc[a][2] += w * pos[b][2];
-                    acc[a][3] += w;
+                let acc = cotangent_sum(v, old, tris, &r, &per_face);
+                if acc[3] <= 0.0 {
+                    return old[v];
                 }
-            }
-        }
-        let old = pos.to_vec();
-        let mut proposed = old.clone();
-        proposed.par_iter_mut().enumerate().for_each(|(v, p)| {
-            if fixed[v] || acc[v][3] <= 0.0 {
-                return;
-            }
-            let target = scale([acc[v][0], acc[v][1], acc[v][2]], 1.0 / acc[v][3]);
-            let faces = &r.vf[r.vf_off[v] as usize..r.vf_off[v + 1] as usize];
-            let mut n = [0.0; 3];
-            for &f in faces {
-                n = add(n, face_normal(&old, tris[f as usize]));
-            }
-            let n = normalize(n);
-            let d = scale(sub(target, old[v]), s.mcf_step);
-            let moved = add(old[v], sub(d, scale(n, dot(d, n))));
-            // Drop back onto the plane of the nearest incident face (current surface).
-            let best = faces.iter().min_by(|&&a, &&b| {
-                let ca = centroid(&old, tris[a as usize]);
-                let cb = centroid(&old, tris[b as usize]);
-                norm2(sub(ca, moved)).total_cmp(&norm2(sub(cb, moved)))
-            });
-            *p = match best {
-                Some(&f) => {
-                    let fnorm = normalize(face_normal(&old, tris[f as usize]));
-                    let o = old[tris[f as usize][0] as usize];
-                    sub(moved, scale(fnorm, dot(sub(moved, o), fnorm)))
+                let target = scale([acc[0], acc[1], acc[2]], 1.0 / acc[3]);
+                let faces = r.vf.row(v);
+                let mut n = [0.0; 3];
+                for &f in faces {
+                    n = add(n, shape[f as usize].0);
                 }
-                None => moved,
-            };
-        });
+                let n = normalize(n);
+                let d = scale(sub(target, old[v]), s.mcf_step);
+                let moved = add(old[v], sub(d, scale(n, dot(d, n))));
+                // Drop back onto the plane of the nearest incident face (current surface).
+                let best = faces.iter().min_by(|&&a, &&b| {
+                    let (ca, cb) = (per_face[a as usize].1, per_face[b as usize].1);
+                    norm2(sub(ca, moved)).total_cmp(&norm2(sub(cb, moved)))
+                });
+                match best {
+                    Some(&f) => {
+                        let fnorm = normalize(shape[f as usize].0);
+                        let o = old[tris[f as usize][0] as usize];
+                        sub(moved, scale(fnorm, dot(sub(moved, o), fnorm)))
+                    }
+                    None => moved,
+                }
+            })
+            .collect();
         // A halved step stays on the plane it was dropped onto (old and new are both on it).
-        commit_safely(pos, &old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q);
+        cur =
+            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q).0;
     }
     // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
-    let reference = pos.to_vec();
-    let mut ref_face: Vec<u32> = (0..nv)
-        .map(|v| if r.vf_off[v] < r.vf_off[v + 1] { r.vf[r.vf_off[v] as usize] } else { u32::MAX })
-        .collect();
+    let reference = cur.clone();
+    // Unit normals of the reference faces (the reference does not move in this stage).
+    let ref_normals: Vec<Point3> =
+        tris.par_iter().with_min_len(4096).map(|&t| normalize(face_normal(&reference, t))).collect();
+    let mut ref_face: Vec<u32> = (0..nv).map(|v| r.vf.row(v).first().copied().unwrap_or(u32::MAX)).collect();
     for it in 0..s.laplacian_iterations {
         progress.fraction((s.mcf_iterations + it) as f64 / total)?;
-        let old = pos.to_vec();
-        let mut proposed = old.clone();
+        let old = &cur;
         let mut new_ref = ref_face.clone();
-        proposed.par_iter_mut().zip(new_ref.par_iter_mut()).enumerate().for_each(|(v, (p, rf))| {
-            let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
-            if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
-                return;
-            }
-            let mut m = [0.0; 3];
-            for &w in nbs {
-                m = add(m, old[w as usize]);
-            }
-            let m = scale(m, 1.0 / nbs.len() as f64);
-            let n = normalize(face_normal(&reference, tris[*rf as usize]));
-            let d = sub(m, old[v]);
-            let moved = add(old[v], sub(d, scale(n, dot(d, n))));
-            let (f, q) = closest_by_walk(&reference, tris, &r, *rf, moved);
-            *rf = f;
-            *p = q;
-        });
+        let proposed: Vec<Point3> = new_ref
+            .par_iter_mut()
+            .enumerate()
+            .map(|(v, rf)| {
+                let nbs = &r.nb[r.nb_off[v] as usize..r.nb_off[v + 1] as usize];
+                if fixed[v] || nbs.is_empty() || *rf == u32::MAX {
+                    return old[v];
+                }
+                let mut m = [0.0; 3];
+                for &w in nbs {
+                    m = add(m, old[w as usize]);
+                }
+                let m = scale(m, 1.0 / nbs.len() as f64);
+                let n = ref_normals[*rf as usize];
+                let d = sub(m, old[v]);
+                let moved = add(old[v], sub(d, scale(n, dot(d, n))));
+                let (f, q) = closest_by_walk(&reference, tris, &r, *rf, moved);
+                *rf = f;
+                q
+            })
+            .collect();
         // A halved step is dropped back onto the reference surface like a full one.
-        let kept = commit_safely(
-            pos,
-            &old,
-            proposed,
-            tris,
-            &r,
-            q_floor,
-            &mut shape,
-            &mut scratch,
-            &mut stats,
-            |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1,
-        );
+        let (next, kept) =
+            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |v, q| {
+                closest_by_walk(&reference, tris, &r, ref_face[v], q).1
+            });
         for v in kept {
-            let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], pos[v as usize]);
+            let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], next[v as usize]);
             new_ref[v as usize] = f;
         }
         for (v, rf) in ref_face.iter_mut().enumerate() {
-            if pos[v] == old[v] {
+            if next[v] == old[v] {
                 continue; // did not move: keep its face
             }
             *rf = new_ref[v];
         }
+        cur = next;
     }
+    pos.copy_from_slice(&cur);
     Ok(stats)
+}
+
+/// The mean-curvature flow's weight of each edge k = (t[k], t[k+1]) of a face: half the cotangent
+/// of the corner opposite it, negative ones clamped to 0 (they make the step leave the ring); NaN
+/// for a degenerate corner, which adds nothing (a computed weight is never NaN: `max` drops a NaN
+/// quotient).
+fn cotangent_weights(pos: &[Point3], t: [u32; 3]) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        let (i, j, o) = (t[k] as usize, t[(k + 1) % 3] as usize, t[(k + 2) % 3] as usize);
+        let (u, v) = (sub(pos[i], pos[o]), sub(pos[j], pos[o]));
+        let cr = norm2(cross(u, v)).sqrt();
+        if cr <= 0.0 {
+            f64::NAN
+        } else {
+            (dot(u, v) / cr).max(0.0) * 0.5
+        }
+    })
+}
+
+/// Σ w·q over the ring of `v` (3) and Σ w, with w the [`cotangent_weights`] (`per_face[f].0`). The
+/// terms are added in the order of a serial face-by-face scatter (faces ascending, as `r.vf`
+/// lists them, then edges in face order), so the sums do not depend on how the vertices are
+/// split among threads.
+fn cotangent_sum(
+    v: usize,
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    r: &Rings,
+    per_face: &[([f64; 3], Point3)],
+) -> [f64; 4] {
+    let mut a = [0.0f64; 4];
+    for &f in r.vf.row(v) {
+        let (t, w) = (tris[f as usize], per_face[f as usize].0);
+        let Some(c) = t.iter().position(|&x| x as usize == v) else { continue };
+        // v is the first end of edge c and the second end of edge c − 1 (mod 3): in edge order.
+        let (before, at) = ((c + 2) % 3, c);
+        for k in if before < at { [before, at] } else { [at, before] } {
+            let other = if k == at { t[(k + 1) % 3] } else { t[k] } as usize;
+            let w = w[k];
+            if w.is_nan() {
+                continue;
+            }
+            a[0] += w * pos[other][0];
+            a[1] += w * pos[other][1];
+            a[2] += w * pos[other][2];
+            a[3] += w;
+        }
+    }
+    a
 }
 
 /// Is the face at `pos` turned against the sum of its corners' `reference` normals (negative),
@@ -334,28 +371,26 @@ fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
 }
 
 #[allow(clippy::too_many_arguments)]
-/// Moves `pos` from `old` to `proposed` where that is safe (see the module doc); `reproject`
-/// puts a halved step back on the surface. Returns the vertices whose step was halved and kept
-/// (their reference face may need updating).
+/// The positions reached from `old` towards `proposed` where that is safe (see the module doc);
+/// `reproject` puts a halved step back on the surface. Also returns the vertices whose step was
+/// halved and kept (their reference face may need updating).
 fn commit_safely(
-    pos: &mut [Point3],
     old: &[Point3],
     proposed: Vec<Point3>,
     tris: &[[u32; 3]],
     r: &Rings,
     q_floor: f64,
-    shape: &mut [(Point3, f64)],
-    new_shape: &mut [(Point3, f64)],
+    shape: &mut Vec<(Point3, f64)>,
+    new_shape: &mut Vec<(Point3, f64)>,
     stats: &mut SmoothStats,
     reproject: impl Fn(usize, Point3) -> Point3 + Sync,
-) -> Vec<u32> {
+) -> (Vec<Point3>, Vec<u32>) {
     let nv = old.len();
     let mut cand = proposed;
-    let moves = cand.iter().zip(old).filter(|(a, b)| a != b).count();
+    let moves = cand.par_iter().zip(old).with_min_len(4096).filter(|(a, b)| a != b).count();
     stats.moves += moves;
     if moves == 0 {
-        pos.copy_from_slice(old);
-        return Vec::new();
+        return (cand, Vec::new());
     }
     // A relative margin so that the reported angle, computed differently, cannot come out lower.
     let floor = q_floor * (1.0 + 1e-9);
@@ -364,14 +399,18 @@ fn commit_safely(
         dot(n, n_old) > 0.0 && (q >= q_old || q >= floor)
     };
     // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
-    // of which moved comes out the same).
-    new_shape
+    // of which moved comes out the same), listing the failing ones in face order (rayon's collect
+    // keeps it, so the halvings below run as after a serial scan).
+    let mut bad: Vec<u32> = new_shape
         .par_iter_mut()
-        .zip(tris.par_iter())
+        .zip(tris.par_iter().zip(shape.par_iter()))
+        .enumerate()
         .with_min_len(4096)
-        .for_each(|(ns, &t)| *ns = face_shape(&cand, t));
-    let mut bad: Vec<u32> =
-        (0..tris.len() as u32).filter(|&f| !acceptable(new_shape[f as usize], shape[f as usize])).collect();
+        .filter_map(|(f, (ns, (&t, &before)))| {
+            *ns = face_shape(&cand, t);
+            (!acceptable(*ns, before)).then_some(f as u32)
+        })
+        .collect();
     let mut halvings = vec![0u8; nv];
     let mut vmark = vec![false; nv];
     let mut fmark = vec![false; tris.len()];
@@ -396,7 +435,7 @@ fn commit_safely(
             } else {
                 reproject(v, scale(add(old[v], cand[v]), 0.5))
             };
-            for &f in &r.vf[r.vf_off[v] as usize..r.vf_off[v + 1] as usize] {
+            for &f in r.vf.row(v) {
                 if !fmark[f as usize] {
                     fmark[f as usize] = true;
                     faces.push(f);
@@ -418,7 +457,7 @@ fn commit_safely(
     }
     // Every face's last evaluation is at the final positions (a face is re-evaluated whenever a
     // corner changes): the next step's old shapes.
-    shape.copy_from_slice(new_shape);
+    std::mem::swap(shape, new_shape);
     let mut halved = Vec::new();
     for (v, &h) in halvings.iter().enumerate() {
         if h as u32 > MAX_HALVINGS {
@@ -428,8 +467,7 @@ fn commit_safely(
             halved.push(v as u32);
         }
     }
-    pos.copy_from_slice(&cand);
-    halved
+    (cand, halved)
 }
 
 fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {

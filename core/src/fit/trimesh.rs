@@ -75,7 +75,9 @@ pub struct TriMesh {
     pub pos: Vec<Point3>,
     pub tris: Vec<[u32; 3]>,
     pub alive: Vec<bool>,
-    half: IntMap<(u32, u32), u32>,
+    /// Live faces at each vertex. The face with a directed edge a → b is found in `vfaces[a]`
+    /// (~6 faces): no directed-edge hash map, whose 600k entries on the headline cost more to
+    /// build, clone and update than these short scans (docs/benchmarks.md, session 11).
     vfaces: Vec<Vec<u32>>,
     /// Live faces (what `alive` counts), and the most the fit lets its stages make
     /// ([`TriMesh::check_growth`]).
@@ -88,11 +90,17 @@ impl TriMesh {
     /// Builds the adjacency; fails naming the face when an edge is used twice in one direction
     /// (non-manifold or inconsistently oriented input).
     pub fn new(pos: Vec<Point3>, tris: Vec<[u32; 3]>) -> Result<Self> {
+        // Each vertex's list sized for its faces and a few edits (one allocation each).
+        let mut valence = vec![0u32; pos.len()];
+        for &v in tris.iter().flatten() {
+            if let Some(c) = valence.get_mut(v as usize) {
+                *c += 1;
+            }
+        }
         let mut m = TriMesh {
-            vfaces: vec![Vec::new(); pos.len()],
+            vfaces: valence.iter().map(|&c| Vec::with_capacity(c as usize + 2)).collect(),
             pos,
             alive: vec![true; tris.len()],
-            half: IntMap::with_capacity_and_hasher(tris.len() * 3, Default::default()),
             tris: Vec::with_capacity(tris.len()),
             live: tris.len(),
             peak: tris.len(),
@@ -103,7 +111,7 @@ impl TriMesh {
                 return Err(Error::Topology(format!("template face {fi} repeats a vertex {t:?}")));
             }
             for k in 0..3 {
-                if let Some(other) = m.half.insert((t[k], t[(k + 1) % 3]), fi as u32) {
+                if let Some(other) = m.face_with_edge(t[k], t[(k + 1) % 3]) {
                     return Err(Error::Topology(format!(
                         "template edge ({}, {}) is used in the same direction by faces {other} and {fi}: \
                          the template is not an oriented manifold (run the repair job first)",
@@ -111,7 +119,10 @@ impl TriMesh {
                         t[(k + 1) % 3]
                     )));
                 }
-                m.vfaces[t[k] as usize].push(fi as u32);
+            }
+            let fi = m.tris.len() as u32;
+            for &v in t {
+                m.vfaces[v as usize].push(fi);
             }
             m.tris.push(*t);
         }
@@ -127,14 +138,13 @@ impl TriMesh {
     /// Adds a face; Err(()) if one of its directed edges is already taken.
     pub fn add_face(&mut self, t: [u32; 3]) -> std::result::Result<u32, ()> {
         for k in 0..3 {
-            if self.half.contains_key(&(t[k], t[(k + 1) % 3])) {
+            if self.face_with_edge(t[k], t[(k + 1) % 3]).is_some() {
                 return Err(());
             }
         }
         let fi = self.tris.len() as u32;
-        for k in 0..3 {
-            self.half.insert((t[k], t[(k + 1) % 3]), fi);
-            self.vfaces[t[k] as usize].push(fi);
+        for &v in &t {
+            self.vfaces[v as usize].push(fi);
         }
         self.tris.push(t);
         self.alive.push(true);
@@ -150,9 +160,8 @@ impl TriMesh {
         let t = self.tris[f as usize];
         self.alive[f as usize] = false;
         self.live -= 1;
-        for k in 0..3 {
-            self.half.remove(&(t[k], t[(k + 1) % 3]));
-            let list = &mut self.vfaces[t[k] as usize];
+        for v in t {
+            let list = &mut self.vfaces[v as usize];
             if let Some(i) = list.iter().position(|&g| g == f) {
                 list.swap_remove(i);
             }
@@ -186,17 +195,22 @@ impl TriMesh {
     }
 
     pub fn has_edge(&self, a: u32, b: u32) -> bool {
-        self.half.contains_key(&(a, b)) || self.half.contains_key(&(b, a))
+        self.face_with_edge(a, b).is_some() || self.face_with_edge(b, a).is_some()
     }
 
-    /// The face that has the directed edge a → b.
+    /// The face that has the directed edge a → b (at most one: [`TriMesh::add_face`] refuses a
+    /// second).
     pub fn face_with_edge(&self, a: u32, b: u32) -> Option<u32> {
-        self.half.get(&(a, b)).copied()
+        let faces = self.vfaces.get(a as usize)?;
+        faces.iter().copied().find(|&f| {
+            let t = self.tris[f as usize];
+            (t[0] == a && t[1] == b) || (t[1] == a && t[2] == b) || (t[2] == a && t[0] == b)
+        })
     }
 
     /// The face on the other side of edge (a, b) from face `f`.
     pub fn across(&self, f: u32, a: u32, b: u32) -> Option<u32> {
-        [self.half.get(&(a, b)), self.half.get(&(b, a))].into_iter().flatten().copied().find(|&g| g != f)
+        [self.face_with_edge(a, b), self.face_with_edge(b, a)].into_iter().flatten().find(|&g| g != f)
     }
 
     /// True when some edge at `v` has a face on one side only.
@@ -205,7 +219,7 @@ impl TriMesh {
             let t = self.tris[f as usize];
             (0..3).any(|k| {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                (a == v || b == v) && !self.half.contains_key(&(b, a))
+                (a == v || b == v) && self.face_with_edge(b, a).is_none()
             })
         })
     }

@@ -78,6 +78,46 @@ impl Csr {
     pub fn rows(&self) -> usize {
         self.offsets.len().saturating_sub(1)
     }
+
+    /// Vertex → triangles of `tris` over `nv` vertices, each row in increasing face order (a
+    /// counting sort: two passes over the corners, no hash map). A face repeating a vertex is
+    /// listed once in that vertex's row; indices `>= nv` are skipped.
+    pub fn vertex_triangles(nv: usize, tris: &[[u32; 3]]) -> Csr {
+        let distinct = |t: &[u32; 3]| {
+            let t = *t;
+            (0..3).filter(move |&k| !t[..k].contains(&t[k])).map(move |k| t[k] as usize)
+        };
+        let mut offsets = vec![0u32; nv + 1];
+        for t in tris {
+            for v in distinct(t).filter(|&v| v < nv) {
+                offsets[v + 1] += 1;
+            }
+        }
+        for i in 0..nv {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut next = offsets.clone();
+        let mut items = vec![0u32; offsets[nv] as usize];
+        for (f, t) in tris.iter().enumerate() {
+            for v in distinct(t).filter(|&v| v < nv) {
+                items[next[v] as usize] = f as u32;
+                next[v] += 1;
+            }
+        }
+        Csr { offsets, items }
+    }
+
+    /// The triangles of `tris` with edge `(a, b)` (either direction), in increasing order, from
+    /// the row of `a` of a [`Csr::vertex_triangles`] table.
+    pub fn triangles_on_edge<'a>(
+        &'a self,
+        tris: &'a [[u32; 3]],
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = u32> + 'a {
+        let row = if (a as usize) < self.rows() { self.row(a as usize) } else { &[] };
+        row.iter().copied().filter(move |&f| tris[f as usize].contains(&b))
+    }
 }
 
 /// Edge and incidence tables of a face list. Build with [`Topology::new`]; it does not borrow the

@@ -217,3 +217,22 @@ fn vertex_faces_dedup_and_neighbors() {
     assert_eq!(nb.row(0), &[1, 2, 3]);
     assert_eq!(nb.row(1), &[0, 2]);
 }
+
+#[test]
+fn vertex_triangles_lists_each_face_once_per_vertex_in_face_order() {
+    // A fin (faces 0, 1, 3 on edge 0–1), a face repeating vertex 2, and one with an index past nv.
+    let tris = [[0, 1, 2], [1, 0, 3], [2, 2, 4], [0, 1, 4], [4, 9, 1]];
+    let vf = Csr::vertex_triangles(5, &tris);
+    assert_eq!(vf.rows(), 5);
+    assert_eq!(vf.row(0), &[0, 1, 3]);
+    assert_eq!(vf.row(1), &[0, 1, 3, 4]);
+    assert_eq!(vf.row(2), &[0, 2]);
+    assert_eq!(vf.row(3), &[1]);
+    assert_eq!(vf.row(4), &[2, 3, 4]);
+    let on = |a, b| vf.triangles_on_edge(&tris, a, b).collect::<Vec<_>>();
+    assert_eq!(on(0, 1), vec![0, 1, 3]);
+    assert_eq!(on(1, 0), vec![0, 1, 3]);
+    assert_eq!(on(2, 4), vec![2]);
+    assert_eq!(on(3, 4), Vec::<u32>::new());
+    assert_eq!(on(7, 1), Vec::<u32>::new(), "a vertex past nv has no row");
+}

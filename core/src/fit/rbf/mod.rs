@@ -6,24 +6,29 @@
 //! the data and reproduces affine functions).
 //!
 //! The system (2.8) has φ(0) = 0 on the diagonal and a 4×4 zero block: it is symmetric
-//! **indefinite** (the thesis's "positive definite" is wrong), so it is solved with a pivoted
-//! LBLᵀ, never Cholesky. It is singular for duplicate centres and for fewer than 4 non-coplanar
-//! ones; both are rejected before the solve with a message naming the centres. Coplanar centres
+//! **indefinite** (the thesis's "positive definite" is wrong), so no Cholesky of the whole system.
+//! It is definite on the null space of the polynomial block (φ = r is conditionally negative
+//! definite): [`cpd_solve`] factors it there with a Cholesky, and a pivoted LBLᵀ of the
+//! whole system is the fallback. It is singular for duplicate centres and for fewer than 4
+//! non-coplanar ones; both are rejected before the solve with a message naming the centres. Coplanar centres
 //! can instead be fitted with the polynomial part restricted to their plane
 //! ([`Rbf::fit_in_plane`]).
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::lu::partial_pivoting::{factor, solve};
-use faer::{Mat, Par};
+use faer::Mat;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::geometry::{dist, Aabb};
+use crate::geometry::Aabb;
 use crate::job::{interruptible, Progress};
 use crate::mesh::Point3;
 
 use super::align::sym_eigen;
 use super::kdtree::KdTree;
+
+mod cpd_solve;
+mod system;
+
+pub use system::{CHOLESKY_CENTRES, CHOLESKY_MIN_SPREAD};
 
 /// The radial function φ.
 #[derive(
@@ -44,6 +49,15 @@ impl Kernel {
         match self {
             Kernel::Linear => r,
             Kernel::Cubic => r * r * r,
+        }
+    }
+
+    /// s with s·wᵀΦw > 0 for weights orthogonal to the affine functions: r is conditionally
+    /// negative definite (order 1), r³ conditionally positive definite (order 2).
+    fn definiteness_sign(self) -> f64 {
+        match self {
+            Kernel::Linear => -1.0,
+            Kernel::Cubic => 1.0,
         }
     }
 }
@@ -231,34 +245,15 @@ impl Rbf {
             .collect();
         let nd = directions.len();
         let m = n + nd + 1;
-        let mut a = Mat::<f64>::zeros(m, m);
-        for i in 0..n {
-            // Symmetric (|q_i − q_j| is bitwise |q_j − q_i|): each distance computed once.
-            for j in 0..i {
-                let v = kernel.phi(dist(q[i], q[j]));
-                a[(i, j)] = v;
-                a[(j, i)] = v;
-            }
-            a[(i, i)] = kernel.phi(0.0);
-            for (k, d) in directions.iter().enumerate() {
-                let x = crate::geometry::dot(*d, q[i]);
-                a[(i, n + k)] = x;
-                a[(n + k, i)] = x;
-            }
-            a[(i, n + nd)] = 1.0;
-            a[(n + nd, i)] = 1.0;
-        }
+        let a = system::matrix(&q, kernel, directions);
         let mut rhs = Mat::<f64>::zeros(m, 3);
         for i in 0..n {
             for k in 0..3 {
                 rhs[(i, k)] = values[i][k];
             }
         }
-        let x = if n >= INTERRUPTIBLE_CENTRES {
-            interruptible(progress, move || symmetric_solve(a, rhs))??
-        } else {
-            symmetric_solve(a, rhs)?
-        };
+        let solve = system::solver(a, rhs, &q, kernel, directions);
+        let x = if n >= INTERRUPTIBLE_CENTRES { interruptible(progress, solve)?? } else { solve()? };
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
         // The polynomial part as the rows x, y, z, 1 of a full affine map (Σ_k d_k ⊗ coefficient_k).
         let mut affine = [[0.0; 3]; 4];
@@ -451,192 +446,11 @@ impl Rbf {
 }
 
 /// From this many centres on, the dense factorisation runs on a worker thread while the job
-/// polls for a cancel ([`interruptible`]): faer's Bunch–Kaufman cannot be interrupted, and at the
-/// headline's ~2,000 centres it takes ~100–200 ms (the fit's worst cancel overshoot, measured by
+/// polls for a cancel ([`interruptible`]): faer's factorisations cannot be interrupted, and at the
+/// headline's ~2,000 centres they take ~50–200 ms (the fit's worst cancel overshoot, measured by
 /// `cancel_latency 8 fit`). On a cancel the factorisation finishes in the background on its own
 /// copy and is dropped. Below this (≤ 8 ms at load 1) the thread is not worth starting.
 pub const INTERRUPTIBLE_CENTRES: usize = 500;
 
-/// Dense symmetric-indefinite solve: Bunch–Kaufman LBLᵀ (half the flops of LU, pivoted, so the
-/// zero diagonal and zero affine block are fine), sequential (faer's parallel mode is never used).
-fn symmetric_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
-    use faer::linalg::cholesky::lblt::{factor as bk, solve as bks};
-    let n = a.nrows();
-    let mut subdiag = faer::diag::Diag::<f64>::zeros(n);
-    let mut perm = vec![0usize; n];
-    let mut perm_inv = vec![0usize; n];
-    let par = Par::Seq;
-    let mut buf = MemBuffer::new(bk::cholesky_in_place_scratch::<usize, f64>(n, par, Default::default()));
-    let (_, p) = bk::cholesky_in_place(
-        a.as_mut(),
-        subdiag.as_mut(),
-        &mut perm,
-        &mut perm_inv,
-        par,
-        MemStack::new(&mut buf),
-        Default::default(),
-    );
-    let mut buf2 = MemBuffer::new(bks::solve_in_place_scratch::<usize, f64>(n, rhs.ncols(), par));
-    bks::solve_in_place(
-        a.as_ref(),
-        a.diagonal(),
-        subdiag.as_ref(),
-        p,
-        rhs.as_mut(),
-        par,
-        MemStack::new(&mut buf2),
-    );
-    Ok(rhs)
-}
-
-/// Dense LU with partial pivoting, sequential (faer's parallel mode is never used: see DESIGN).
-#[allow(dead_code)]
-fn lu_solve(mut a: Mat<f64>, mut rhs: Mat<f64>) -> Result<Mat<f64>> {
-    let n = a.nrows();
-    let mut perm = vec![0usize; n];
-    let mut perm_inv = vec![0usize; n];
-    let par = Par::Seq;
-    let mut buf = MemBuffer::new(factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()));
-    let (_, p) = factor::lu_in_place(
-        a.as_mut(),
-        &mut perm,
-        &mut perm_inv,
-        par,
-        MemStack::new(&mut buf),
-        Default::default(),
-    );
-    let mut buf2 = MemBuffer::new(solve::solve_in_place_scratch::<usize, f64>(n, rhs.ncols(), par));
-    solve::solve_in_place(a.as_ref(), a.as_ref(), p, rhs.as_mut(), par, MemStack::new(&mut buf2));
-    Ok(rhs)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn cube_corners() -> Vec<Point3> {
-        let mut v = Vec::new();
-        for i in 0..8 {
-            v.push([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);
-        }
-        v.push([0.3, 0.7, 0.2]);
-        v
-    }
-
-    #[test]
-    fn interpolates_exactly_at_centres() {
-        let c = cube_corners();
-        // Arbitrary non-affine values (hand-picked numbers).
-        let vals: Vec<Point3> =
-            (0..c.len()).map(|i| [i as f64 * 0.1, (i * i) as f64 * 0.01, -(i as f64)]).collect();
-        for kernel in [Kernel::Linear, Kernel::Cubic] {
-            let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
-            for (p, v) in c.iter().zip(&vals) {
-                let e = f.eval(*p);
-                for k in 0..3 {
-                    assert!((e[k] - v[k]).abs() < 1e-10, "{kernel:?} {e:?} vs {v:?}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn reproduces_an_affine_map_everywhere() {
-        let c = cube_corners();
-        // d(x) = A x + b, hand-chosen.
-        let a = [[0.5, 0.1, 0.0], [-0.2, 0.3, 0.4], [0.0, 0.0, -0.7]];
-        let b = [1.0, -2.0, 0.5];
-        let d = |p: Point3| -> Point3 {
-            let mut r = b;
-            for i in 0..3 {
-                for j in 0..3 {
-                    r[i] += a[i][j] * p[j];
-                }
-            }
-            r
-        };
-        let vals: Vec<Point3> = c.iter().map(|&p| d(p)).collect();
-        let f = Rbf::fit(&c, &vals, Kernel::Linear, "test").unwrap();
-        for p in [[5.0, -3.0, 2.0], [0.5, 0.5, 0.5], [-10.0, 0.0, 7.5]] {
-            let (e, t) = (f.eval(p), d(p));
-            for k in 0..3 {
-                assert!((e[k] - t[k]).abs() < 1e-9 * (1.0 + t[k].abs()), "{e:?} vs {t:?}");
-            }
-        }
-    }
-
-    #[test]
-    fn simd_and_scalar_sums_agree() {
-        // 23 centres (not a multiple of 4: the tail runs too), pseudo-random values.
-        let c: Vec<Point3> = (0..23)
-            .map(|i| [(i as f64 * 0.37).sin(), (i as f64 * 0.91).cos(), (i * i % 7) as f64 * 0.1])
-            .collect();
-        let vals: Vec<Point3> =
-            (0..23).map(|i| [(i as f64).sin(), 0.1 * i as f64, -0.05 * (i % 5) as f64]).collect();
-        for kernel in [Kernel::Linear, Kernel::Cubic] {
-            let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
-            for q in [[0.1, 0.2, 0.3], [-2.0, 1.0, 0.5]] {
-                let a = match kernel {
-                    Kernel::Linear => f.radial_sum(q, |r| r),
-                    Kernel::Cubic => f.radial_sum(q, |r| r * r * r),
-                };
-                let b = f.radial(q);
-                for (x, y) in [(a.0, b.0), (a.1, b.1), (a.2, b.2)] {
-                    assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{kernel:?}: {x} vs {y}");
-                }
-            }
-        }
-    }
-
-    /// Centres on a Fibonacci sphere (no two alike, none coplanar) and a smooth displacement.
-    fn sphere_data(n: usize) -> (Vec<Point3>, Vec<Point3>) {
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let c: Vec<Point3> = (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let r = (1.0 - z * z).sqrt();
-                let t = golden * i as f64;
-                [r * t.cos(), r * t.sin(), z]
-            })
-            .collect();
-        let v = c.iter().map(|p| [0.1 * p[1], 0.05 * p[0] * p[2], -0.02 * p[2] * p[2]]).collect();
-        (c, v)
-    }
-
-    #[test]
-    fn a_large_solve_stops_at_a_cancel_during_the_factorisation() {
-        // 1,500 centres: the factorisation takes tens of ms, far more than the 1 ms between the
-        // polls made while it runs. Poll 1 is the entry check, poll 2 the first one during the
-        // factorisation: cancelled there, the fit returns Cancelled without waiting for it.
-        let (c, v) = sphere_data(1500);
-        assert!(c.len() >= INTERRUPTIBLE_CENTRES);
-        let p = Progress::new();
-        p.cancel_at_check(2);
-        assert!(matches!(Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &p), Err(Error::Cancelled)));
-        assert_eq!(p.checks(), 2);
-        // Not cancelled, the same fit interpolates (the worker thread's result is used).
-        let f = Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &Progress::new()).unwrap();
-        for i in [0, 777, 1499] {
-            let e = f.eval(c[i]);
-            for k in 0..3 {
-                assert!((e[k] - v[i][k]).abs() < 1e-9, "{e:?} vs {:?}", v[i]);
-            }
-        }
-        // Below the threshold nothing is polled inside the fit.
-        let (c, v) = sphere_data(100);
-        let p = Progress::new();
-        Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &p).unwrap();
-        assert_eq!(p.checks(), 0);
-    }
-
-    #[test]
-    fn duplicate_and_coplanar_centres_are_rejected() {
-        let mut c = cube_corners();
-        c.push(c[3]);
-        assert_eq!(check_centres(&c), Err(Degenerate::Duplicate(3, 9)));
-        let flat: Vec<Point3> = (0..10).map(|i| [i as f64, (i * i % 7) as f64, 2.0]).collect();
-        assert!(matches!(check_centres(&flat), Err(Degenerate::Coplanar(_))));
-        assert_eq!(check_centres(&c[..3]), Err(Degenerate::TooFew(3)));
-        assert!(Rbf::fit(&flat, &flat, Kernel::Linear, "x").is_err());
-    }
-}
+mod tests;

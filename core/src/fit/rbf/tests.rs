@@ -1,0 +1,142 @@
+use super::*;
+
+fn cube_corners() -> Vec<Point3> {
+    let mut v = Vec::new();
+    for i in 0..8 {
+        v.push([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);
+    }
+    v.push([0.3, 0.7, 0.2]);
+    v
+}
+
+#[test]
+fn interpolates_exactly_at_centres() {
+    let c = cube_corners();
+    // Arbitrary non-affine values (hand-picked numbers).
+    let vals: Vec<Point3> =
+        (0..c.len()).map(|i| [i as f64 * 0.1, (i * i) as f64 * 0.01, -(i as f64)]).collect();
+    for kernel in [Kernel::Linear, Kernel::Cubic] {
+        let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
+        for (p, v) in c.iter().zip(&vals) {
+            let e = f.eval(*p);
+            for k in 0..3 {
+                assert!((e[k] - v[k]).abs() < 1e-10, "{kernel:?} {e:?} vs {v:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn reproduces_an_affine_map_everywhere() {
+    let c = cube_corners();
+    // d(x) = A x + b, hand-chosen.
+    let a = [[0.5, 0.1, 0.0], [-0.2, 0.3, 0.4], [0.0, 0.0, -0.7]];
+    let b = [1.0, -2.0, 0.5];
+    let d = |p: Point3| -> Point3 {
+        let mut r = b;
+        for i in 0..3 {
+            for j in 0..3 {
+                r[i] += a[i][j] * p[j];
+            }
+        }
+        r
+    };
+    let vals: Vec<Point3> = c.iter().map(|&p| d(p)).collect();
+    let f = Rbf::fit(&c, &vals, Kernel::Linear, "test").unwrap();
+    for p in [[5.0, -3.0, 2.0], [0.5, 0.5, 0.5], [-10.0, 0.0, 7.5]] {
+        let (e, t) = (f.eval(p), d(p));
+        for k in 0..3 {
+            assert!((e[k] - t[k]).abs() < 1e-9 * (1.0 + t[k].abs()), "{e:?} vs {t:?}");
+        }
+    }
+}
+
+#[test]
+fn simd_and_scalar_sums_agree() {
+    // 23 centres (not a multiple of 4: the tail runs too), pseudo-random values.
+    let c: Vec<Point3> = (0..23)
+        .map(|i| [(i as f64 * 0.37).sin(), (i as f64 * 0.91).cos(), (i * i % 7) as f64 * 0.1])
+        .collect();
+    let vals: Vec<Point3> =
+        (0..23).map(|i| [(i as f64).sin(), 0.1 * i as f64, -0.05 * (i % 5) as f64]).collect();
+    for kernel in [Kernel::Linear, Kernel::Cubic] {
+        let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
+        for q in [[0.1, 0.2, 0.3], [-2.0, 1.0, 0.5]] {
+            let a = match kernel {
+                Kernel::Linear => f.radial_sum(q, |r| r),
+                Kernel::Cubic => f.radial_sum(q, |r| r * r * r),
+            };
+            let b = f.radial(q);
+            for (x, y) in [(a.0, b.0), (a.1, b.1), (a.2, b.2)] {
+                assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()), "{kernel:?}: {x} vs {y}");
+            }
+        }
+    }
+}
+
+/// Centres on a Fibonacci sphere (no two alike, none coplanar) and a smooth displacement.
+fn sphere_data(n: usize) -> (Vec<Point3>, Vec<Point3>) {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let c: Vec<Point3> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let t = golden * i as f64;
+            [r * t.cos(), r * t.sin(), z]
+        })
+        .collect();
+    let v = c.iter().map(|p| [0.1 * p[1], 0.05 * p[0] * p[2], -0.02 * p[2] * p[2]]).collect();
+    (c, v)
+}
+
+#[test]
+fn fits_run_by_every_worker_of_the_global_pool_finish() {
+    // Each worker waits (not as a rayon task) for its factorisation thread. Had that thread
+    // asked the same pool for faer's tasks, no worker would be free to run them: a hang.
+    let (c, v) = sphere_data(800);
+    assert!(c.len() >= CHOLESKY_CENTRES && spread_ratios(&c)[0] >= CHOLESKY_MIN_SPREAD);
+    let n = rayon::current_num_threads();
+    let ok = (0..n)
+        .into_par_iter()
+        .map(|_| Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &Progress::new()).is_ok())
+        .filter(|&ok| ok)
+        .count();
+    assert_eq!(ok, n);
+}
+
+#[test]
+fn a_large_solve_stops_at_a_cancel_during_the_factorisation() {
+    // 1,500 centres: the factorisation takes tens of ms, far more than the 1 ms between the
+    // polls made while it runs. Poll 1 is the entry check, poll 2 the first one during the
+    // factorisation: cancelled there, the fit returns Cancelled without waiting for it.
+    let (c, v) = sphere_data(1500);
+    assert!(c.len() >= INTERRUPTIBLE_CENTRES);
+    let p = Progress::new();
+    p.cancel_at_check(2);
+    assert!(matches!(Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &p), Err(Error::Cancelled)));
+    assert_eq!(p.checks(), 2);
+    // Not cancelled, the same fit interpolates (the worker thread's result is used).
+    let f = Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &Progress::new()).unwrap();
+    for i in [0, 777, 1499] {
+        let e = f.eval(c[i]);
+        for k in 0..3 {
+            assert!((e[k] - v[i][k]).abs() < 1e-9, "{e:?} vs {:?}", v[i]);
+        }
+    }
+    // Below the threshold nothing is polled inside the fit.
+    let (c, v) = sphere_data(100);
+    let p = Progress::new();
+    Rbf::fit_polled(&c, &v, Kernel::Linear, "test", &p).unwrap();
+    assert_eq!(p.checks(), 0);
+}
+
+#[test]
+fn duplicate_and_coplanar_centres_are_rejected() {
+    let mut c = cube_corners();
+    c.push(c[3]);
+    assert_eq!(check_centres(&c), Err(Degenerate::Duplicate(3, 9)));
+    let flat: Vec<Point3> = (0..10).map(|i| [i as f64, (i * i % 7) as f64, 2.0]).collect();
+    assert!(matches!(check_centres(&flat), Err(Degenerate::Coplanar(_))));
+    assert_eq!(check_centres(&c[..3]), Err(Degenerate::TooFew(3)));
+    assert!(Rbf::fit(&flat, &flat, Kernel::Linear, "x").is_err());
+}
