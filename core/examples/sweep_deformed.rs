@@ -119,7 +119,7 @@ fn main() {
                         }
                         let ok = r["flipped_faces"] == 0 && r["segments_as_edges"] == 1.0;
                         println!(
-                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {}",
+                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {}",
                             if ok { "ok " } else { "BAD" },
                             r["flipped_faces"],
                             r["flipped_faces_after_fine"],
@@ -128,6 +128,8 @@ fn main() {
                             r["regions"],
                             r["folded_edges"],
                             r["alignment"]["ambiguous"],
+                            r["retriangulation"]["failed_pieces"],
+                            r["retriangulation"]["off_surface_segments"],
                         );
                     }
                 }
