@@ -110,8 +110,8 @@ fn main() {
                             .fold(0.0, f64::max);
                         if std::env::var("SWEEP_DETAIL").is_ok() {
                             eprintln!(
-                                "  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",
-                                r["untangle"], r["cleanup"], r["retriangulation"], r["folds"]
+                                "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",
+                                r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"]
                             );
                         }
                         if std::env::var("SWEEP_FOLDS").is_ok() {

@@ -225,3 +225,50 @@ fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
     eprintln!("alignment {a}");
     assert_eq!(a["ambiguous"], true, "{a}");
 }
+
+/// A flat open figure fitted to its own sections (the alligator, repaired, holes left open): the
+/// template already lies on the curves, yet the automatic alignment's score preferred the pose
+/// turned over (the curve ends' gap to the rim outweighed a warp 6× closer to the curves), and
+/// every output face came out against the truth without a word. Invariant (truth: the template
+/// itself): an output turned over — most faces against the closest template face — must be
+/// reported as ambiguous.
+#[test]
+fn a_turned_over_result_is_never_silent() {
+    use meshwork_core::geometry::{dot, triangle_cross};
+    use meshwork_core::mesh::Faces;
+    use meshwork_core::repair::{self, RepairParams};
+    use meshwork_core::spatial::Bvh;
+    let params = RepairParams { fill_holes: false, ..Default::default() };
+    let mut m = repair::run(shared("alligator"), &params, &Progress::new()).expect("repair").meshes.remove(0);
+    to_unit_box(&mut m);
+    let curves = plane_sections(&m, &sweep_planes(&m));
+    let fit_params =
+        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
+    let out = run(vec![m.clone(), curves], &fit_params, &Progress::new()).expect("fit");
+    let truth = m.faces.triangles();
+    let bvh = Bvh::new(&m.positions, &Faces::from_triangles(&truth));
+    let o = &out.meshes[0];
+    let tris = o.faces.triangles();
+    let against = tris
+        .iter()
+        .filter(|t| {
+            let q = |k: usize| o.positions[t[k] as usize];
+            let c = [0, 1, 2].map(|k| (q(0)[k] + q(1)[k] + q(2)[k]) / 3.0);
+            bvh.closest(c).is_some_and(|h| {
+                let g = |k: usize| m.positions[truth[h.face as usize][k] as usize];
+                dot(triangle_cross(q(0), q(1), q(2)), triangle_cross(g(0), g(1), g(2))) < 0.0
+            })
+        })
+        .count();
+    let a = &out.report["alignment"];
+    eprintln!("{against} of {} faces against the truth; alignment {a}", tris.len());
+    if 2 * against > tris.len() {
+        assert_eq!(
+            a["ambiguous"],
+            true,
+            "turned over ({against} of {} faces) and not reported: {a}",
+            tris.len()
+        );
+        assert!(a["warning"].as_str().is_some_and(|w| w.contains("pairs")), "{a}");
+    }
+}
