@@ -55,8 +55,51 @@ fn flat(level: u32, thick: f64) -> Mesh {
     m
 }
 
+/// sweep_unseen's "flat icosphere 4 vs sections of ellipsoid 1×0.6×0.04": the template is the
+/// source's shape at a coarser level. The alignment's warp trimmed the curve points at the tips
+/// (its cut, 2.5 × the median distance, was ~7.5e-5 where the sheets fit), left the template 0.0037
+/// too far along its long axis, and the fit folded the rim. Fixed by the warp's trim floor
+/// (`fit/align/warp.rs`, `TRIM_FLOOR_SEGMENTS`, `TRIM_FLOOR_SAGS`). Counted independently, against
+/// the ellipsoid's normal: without the floor 100 output faces turned over (the report, against the
+/// fine surface: 14); with it 2 (the floor alone, without its sag rule: 0, but that moved a faceted
+/// template off its exact place, see fit_align's `the_warp_does_not_chase_a_templates_faceting`).
+/// The bound leaves room for the thin rim's sensitivity to the floor (session 11: floors of 1 / 1.25
+/// / 1.5 / 2 / 3 segments gave 5 / 0 / 0 / 3 / 3 flipped faces) and still fails without the floor.
 #[test]
-#[ignore = "open: thin rims fold (main: 163 flipped faces, 16 of 20 regions); see docs/benchmarks.md, 'Thin shapes'"]
+fn the_alignment_keeps_a_thin_template_rim_on_the_sections() {
+    let surface = flat(5, 0.04);
+    let planes = sweep_planes(&surface);
+    let curves = plane_sections(&surface, &planes);
+    let out = run(vec![flat(4, 0.04), curves], &FitParams::default(), &Progress::new()).expect("fit");
+    let r = &out.report;
+    assert_eq!(r["regions"].as_u64(), Some(section_regions(&surface, &planes) as u64));
+    assert_eq!(r["segments_as_edges"].as_f64(), Some(1.0));
+    assert_eq!(r["flipped_faces"].as_u64(), Some(0), "flipped {}", r["flipped_faces"]);
+    let turned = against_the_ellipsoid(&out.meshes[0], 0.04);
+    assert!(turned <= 4, "{turned} output faces turned against the ellipsoid's normal (no floor: 100)");
+}
+
+/// Faces of `m` whose normal opposes the normal of the ellipsoid 1 × 0.6 × `thick` centred at
+/// (0.5, 0.5, 0.5), taken as its gradient at the face's centroid.
+fn against_the_ellipsoid(m: &Mesh, thick: f64) -> usize {
+    let axes2 = [0.25, 0.09, thick * thick / 4.0];
+    m.faces
+        .triangles()
+        .iter()
+        .filter(|t| {
+            let p: Vec<[f64; 3]> = t.iter().map(|&v| m.positions[v as usize]).collect();
+            let grad: Vec<f64> =
+                (0..3).map(|k| ((p[0][k] + p[1][k] + p[2][k]) / 3.0 - 0.5) / axes2[k]).collect();
+            let u: Vec<f64> = (0..3).map(|k| p[1][k] - p[0][k]).collect();
+            let v: Vec<f64> = (0..3).map(|k| p[2][k] - p[0][k]).collect();
+            let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+            n[0] * grad[0] + n[1] * grad[1] + n[2] * grad[2] < 0.0
+        })
+        .count()
+}
+
+#[test]
+#[ignore = "open: thin rims fold (session 11: 181 flipped faces, 16 of 20 regions); see docs/benchmarks.md, 'Thin shapes'"]
 fn a_flat_template_fits_bent_sections_of_a_thin_ellipsoid() {
     let surface = flat(5, 0.04);
     let planes = sweep_planes(&surface);

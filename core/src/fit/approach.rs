@@ -227,7 +227,7 @@ pub fn approach(
 }
 
 /// The curves' median segment length.
-fn median_segment(net: &CurveNetwork) -> f64 {
+pub(super) fn median_segment(net: &CurveNetwork) -> f64 {
     let mut l: Vec<f64> =
         net.segments.iter().map(|s| dist(net.points[s[0] as usize], net.points[s[1] as usize])).collect();
     if l.is_empty() {

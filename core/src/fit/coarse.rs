@@ -148,7 +148,15 @@ fn automatic(
     for c in candidates {
         let warped = if c.contender {
             let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
-            let w = align::warp_icp(&mut p, tris, &net.points, Some(&ends), WARP_ITERATIONS, progress)?;
+            let w = align::warp_icp(
+                &mut p,
+                tris,
+                &net.points,
+                super::approach::median_segment(net),
+                Some(&ends),
+                WARP_ITERATIONS,
+                progress,
+            )?;
             let gap = rim.end_gap(&p);
             let score = (w.rms_all_after.powi(2) + gap.unwrap_or(0.0).powi(2)).sqrt();
             Some((p, w, score, gap))
@@ -285,7 +293,15 @@ fn pairs_similarity(
     for p in pos.iter_mut() {
         *p = sim.apply(*p);
     }
-    let warp = align::warp_icp(pos, tris, &net.points, None, WARP_ITERATIONS, progress)?;
+    let warp = align::warp_icp(
+        pos,
+        tris,
+        &net.points,
+        super::approach::median_segment(net),
+        None,
+        WARP_ITERATIONS,
+        progress,
+    )?;
     Ok(CoarseReport {
         method: "pairs_similarity",
         pair_curve_points: fixed.iter().map(|x| x.0).collect(),

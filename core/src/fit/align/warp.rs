@@ -3,7 +3,7 @@
 //! to its last step that folds no face.
 
 use crate::error::{Error, Result};
-use crate::geometry::{add, norm2, scale, sub};
+use crate::geometry::{add, dist, dot, norm2, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -77,6 +77,39 @@ fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
     add(a, scale(ab, t))
 }
 
+/// Matches within this many curve segments (the median) of the surface are never trimmed.
+///
+/// Why: the trim is for curves running off the template, and its cut (2.5 × the median distance)
+/// shrinks with the fit. Where the template fits most curves closely, the cut fell below the
+/// distances that still carry the pose: on a flattened ellipsoid 1 × 0.6 × 0.04 (sweep_unseen) the
+/// sheets fit to ~3e-5, the cut was ~7.5e-5, and the curve points at the tips, 0.0025–0.003 off,
+/// were dropped; the template stayed 0.0037 too far along its long axis, its rim beyond the curves'
+/// rim by 5 × the rim's radius of curvature, and the fit folded the rim (14 flipped faces in the
+/// report, 100 against the analytic normal; with this floor 0 and 0). Measured there, floors of
+/// 1 / 1.25 / 1.5 / 2 / 3 segments: 5 / 0 / 0 / 3 / 3 flipped faces. Feet on faces touching an
+/// open boundary keep the plain cut: with the floor there, "curves past an open template's rim"
+/// (sweep_unseen) stretched the template over the curves instead of reporting them
+/// (docs/benchmarks.md, fit-thin, session 11).
+const TRIM_FLOOR_SEGMENTS: f64 = 1.25;
+
+/// The floor keeps a match only when it is farther than this many times the sag of its foot's
+/// face ([`face_sags`]): a distance the template's faceting explains says nothing about the pose.
+///
+/// Why: on a faceted template whose faces are long against the curves' curvature, the curve points
+/// between two rings of vertices lie up to a sag off the faces, and the floor (1.25 median
+/// segments: 0.38 on a sparse network) kept all of them. The warp then chased the faceting: the
+/// needle UV sphere (512 × 6, sag 0.034–0.048) affinely placed exactly on the ellipsoid of its
+/// curves (every vertex on it) was moved by up to 0.070 and its poles by 0.030–0.042 off the
+/// curves' crossings; in the fit (fit_unseen9, `a_template_of_needles_is_not_decimated`) the
+/// crossings were then inserted next to the poles, their segments crossed tens of the pole fans'
+/// spokes, the re-triangulation's flips left fans of slivers along the first rings and the
+/// clean-up removed 80 vertices (5,076 faces out of 5,120). With this factor the rescued matches
+/// of the thin ellipsoid, 3–20 sags off at first, are kept, and the needle sphere's are not
+/// (0.5–1.9 sags). Measured on those two, factors 1 / 1.25 / 1.5 / 3 / 4: thin 1 / 0 / 0 / 1 / 24
+/// flipped faces (report), needles 5,194 / 5,194 / 5,194 / 5,196 / 5,196 faces
+/// (docs/benchmarks.md, fit-thin, session 12).
+const TRIM_FLOOR_SAGS: f64 = 1.5;
+
 /// Monomials of degree ≤ 2 of `u` (1, u, v, w, u², v², w², uv, vw, wu); `degree` 1 keeps 4.
 fn monomials(u: Point3, degree: usize) -> ([f64; 10], usize) {
     let m =
@@ -127,13 +160,19 @@ fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Option<Vec<[f64; 3]>> {
 /// with few parameters is stiff, so iterating closest points moves it tangentially too (the shape
 /// of the curve network pins it), which a sparse interpolating RBF cannot do.
 ///
-/// Guards: matches farther than 2.5× the median are trimmed; every coefficient is pulled towards
+/// Guards: matches farther than 2.5× the median distance are trimmed, unless within
+/// [`TRIM_FLOOR_SEGMENTS`] × `spacing` (the curves' median segment; 0 for no floor) on a face away
+/// from the template's open boundary and farther than [`TRIM_FLOOR_SAGS`] × that face's sag (its
+/// faceting, measured once on the template as given to the warp); every coefficient is pulled towards
 /// zero by a ridge term, the quadratic ones harder, so directions the curves do not determine
 /// (all curves on one plane) stay put; a step that would fold faces is halved (then stops).
+/// `rim`: the template's rim and the curve ends near it, matched to it in every iteration
+/// ([`RimEnds`]; `None` leaves them out).
 pub fn warp_icp(
     pos: &mut [Point3],
     tris: &[[u32; 3]],
     points: &[Point3],
+    spacing: f64,
     rim: Option<&RimEnds>,
     iterations: u32,
     progress: &Progress,
@@ -151,11 +190,25 @@ pub fn warp_icp(
         return Ok(report);
     }
     let mut tracked = TrackedFeet::new(pos, tris, points, &which, progress)?;
+    // Faces touching the template's open boundary: a foot there may be a curve running off the
+    // template, which the trim is for, so the floor does not keep it.
+    let on_rim: Vec<bool> = {
+        let rim = super::super::trimesh::boundary_vertices(pos.len(), tris);
+        tris.iter().map(|t| t.iter().any(|&v| rim[v as usize])).collect()
+    };
+    let sag = face_sags(pos, tris);
     let trimmed = |feet: &[(u32, Point3, f64)]| -> (Vec<usize>, f64) {
         let mut d: Vec<f64> = feet.iter().map(|f| f.2).collect();
         d.sort_by(f64::total_cmp);
         let cut = 2.5 * d[d.len() / 2];
-        let keep: Vec<usize> = (0..feet.len()).filter(|&i| feet[i].2 <= cut.max(1e-300)).collect();
+        let floor = TRIM_FLOOR_SEGMENTS * spacing;
+        let keep: Vec<usize> = (0..feet.len())
+            .filter(|&i| {
+                let f = feet[i];
+                let face = f.0 as usize;
+                f.2 <= cut.max(1e-300) || (f.2 <= floor && !on_rim[face] && f.2 > TRIM_FLOOR_SAGS * sag[face])
+            })
+            .collect();
         let rms =
             (keep.iter().map(|&i| feet[i].2 * feet[i].2).sum::<f64>() / keep.len().max(1) as f64).sqrt();
         (keep, rms)
@@ -244,6 +297,25 @@ pub fn warp_icp(
     report.rms_after = trimmed(&feet).1;
     report.rms_all_after = (feet.iter().map(|f| f.2 * f.2).sum::<f64>() / feet.len().max(1) as f64).sqrt();
     Ok(report)
+}
+
+/// Per face, how far its flat triangle may lie from the smooth surface it stands for: the largest,
+/// over its edges, of the sag of the circular arc through the edge's ends with the ends' vertex
+/// normals, (length / 2) · tan(θ / 4) for normals θ apart (0 on a flat part, ~0.034 on a unit
+/// sphere's faces spanning 30° of latitude).
+fn face_sags(pos: &[Point3], tris: &[[u32; 3]]) -> Vec<f64> {
+    let normals = super::super::report::vertex_normals(pos, tris);
+    tris.iter()
+        .map(|t| {
+            (0..3)
+                .map(|k| {
+                    let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                    let theta = dot(normals[a], normals[b]).clamp(-1.0, 1.0).acos();
+                    0.5 * dist(pos[a], pos[b]) * (theta / 4.0).tan()
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect()
 }
 
 /// Faces or vertices handled between two polls while [`TrackedFeet`] builds its adjacency.
