@@ -145,6 +145,9 @@ fn automatic(
     let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
     let mut tried: Vec<(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)> =
         Vec::new();
+    // The contenders' scores with the warp of the curve points alone, when the rim term changes
+    // anything ([`plain_scores`]).
+    let plain = plain_scores(pos, tris, net, &rim, &candidates, progress)?;
     for c in candidates {
         let warped = if c.contender {
             let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
@@ -184,7 +187,8 @@ fn automatic(
         })
         .collect();
     let runner_up = tried.get(1).map(score).unwrap_or(f64::INFINITY);
-    let ambiguous = runner_up <= AMBIGUOUS_RATIO * best;
+    let ambiguous =
+        runner_up <= AMBIGUOUS_RATIO * best || (plain.len() > 1 && plain[1] <= AMBIGUOUS_RATIO * plain[0]);
     let warning = ambiguous.then(|| {
         format!(
             "automatic alignment is ambiguous: a pose turned {:.0}° from the chosen one fits the curves almost \
@@ -203,6 +207,41 @@ fn automatic(
         ambiguous,
         warning,
     })
+}
+
+/// The contenders' scores (as in [`automatic`]) after the warp without the curve ends' rim
+/// matches, best first; empty when the template has no rim or the network no ends (the warp is
+/// then the same). Why: the rim matches let one pose's warp follow the curves far better than
+/// another's, also when every contender is wrong: woody's bent sections (`fit_align.rs`), whose
+/// contenders are all turned 40–180° from the truth, scored 1.35× apart with them and within
+/// 1.25× without. An ambiguity either warp sees is reported (session 12, fit-raw).
+fn plain_scores(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    rim: &Rim,
+    candidates: &[align::Candidate],
+    progress: &Progress,
+) -> Result<Vec<f64>> {
+    if rim.edges.is_empty() || rim.ends.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut scores = Vec::new();
+    for c in candidates.iter().filter(|c| c.contender) {
+        let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
+        let w = align::warp_icp(
+            &mut p,
+            tris,
+            &net.points,
+            super::approach::median_segment(net),
+            None,
+            WARP_ITERATIONS,
+            progress,
+        )?;
+        scores.push((w.rms_all_after.powi(2) + rim.end_gap(&p).unwrap_or(0.0).powi(2)).sqrt());
+    }
+    scores.sort_by(f64::total_cmp);
+    Ok(scores)
 }
 
 /// Each curve end's gap to the rim is capped at this × the curves' bounding-box diagonal (see
