@@ -141,13 +141,17 @@ fn automatic(
     progress: &Progress,
 ) -> Result<CoarseReport> {
     let rim = Rim::new(tris, net, progress)?;
-    let ends = align::RimEnds { edges: &rim.edges, ends: &rim.ends, cap: rim.cap };
+    // The ends' rim matches only for curves in one plane ([`PLANAR_CURVES`]).
+    let no_ends: Vec<Point3> = Vec::new();
+    let planar = rbf::spread_ratios(&net.points)[0] < PLANAR_CURVES;
+    let ends =
+        align::RimEnds { edges: &rim.edges, ends: if planar { &rim.ends } else { &no_ends }, cap: rim.cap };
     let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
     let mut tried: Vec<(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)> =
         Vec::new();
     // The contenders' scores with the warp of the curve points alone, when the rim term changes
     // anything ([`plain_scores`]).
-    let plain = plain_scores(pos, tris, net, &rim, &candidates, progress)?;
+    let plain = if planar { plain_scores(pos, tris, net, &rim, &candidates, progress)? } else { Vec::new() };
     for c in candidates {
         let warped = if c.contender {
             let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
@@ -211,7 +215,7 @@ fn automatic(
 
 /// The contenders' scores (as in [`automatic`]) after the warp without the curve ends' rim
 /// matches, best first; empty when the template has no rim or the network no ends (the warp is
-/// then the same). Why: the rim matches let one pose's warp follow the curves far better than
+/// then the same; the caller skips it for curves off one plane, which get no rim matches). Why: the rim matches let one pose's warp follow the curves far better than
 /// another's, also when every contender is wrong: woody's bent sections (`fit_align.rs`), whose
 /// contenders are all turned 40–180° from the truth, scored 1.35× apart with them and within
 /// 1.25× without. An ambiguity either warp sees is reported (session 12, fit-raw).
@@ -243,6 +247,15 @@ fn plain_scores(
     scores.sort_by(f64::total_cmp);
     Ok(scores)
 }
+
+/// Curves whose smallest spread is under this share of the largest lie in one plane: the warp then
+/// matches their ends to the rim ([`align::RimEnds`]). Why only then: curves in the plane of a flat
+/// template lie on it wherever it sits in that plane, every closest-point match is ~0 and only the
+/// ends tell the pose (woody and alligator raw under their own sections). Curves off that plane
+/// (sweep_fit's bent sections of the same meshes) do carry normal distances; there the rim matches
+/// moved woody's row, whose every contender is a wrong pose, from 10 to 9 of 11 regions at every
+/// weight tried (1/10–1/3) (session 12, fit-raw).
+const PLANAR_CURVES: f64 = 1e-3;
 
 /// Each curve end's gap to the rim is capped at this × the curves' bounding-box diagonal (see
 /// [`automatic`]).
