@@ -60,22 +60,36 @@ pub(super) fn matrix(q: &[Point3], kernel: Kernel, directions: &[Point3]) -> Mat
     a
 }
 
+/// Which factorisation solves the system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Method {
+    /// The null-space Cholesky where it applies (many centres spread in 3D), else the LBLᵀ.
+    Fastest,
+    /// The pivoted LBLᵀ of the whole system: slower, and the more accurate on near-singular
+    /// systems (feet a hair apart going to distant points).
+    Pivoted,
+}
+
 /// The solve of `a x = rhs` (a from [`matrix`] of the normalised centres `q`), to run on the
 /// job's thread or on one of its own. Which factorisation, and faer's parallelism, are decided
-/// here, on the calling thread ([`cpd_solve::parallelism`]).
+/// here, on the calling thread ([`cpd_solve::parallelism`]). Also returns whether the
+/// null-space Cholesky is tried.
 pub(super) fn solver(
     a: Mat<f64>,
     rhs: Mat<f64>,
     q: &[Point3],
     kernel: Kernel,
     directions: &[Point3],
-) -> impl FnOnce() -> Result<Mat<f64>> + Send + 'static {
+    method: Method,
+) -> (bool, impl FnOnce() -> Result<Mat<f64>> + Send + 'static) {
     let n = q.len();
-    let cholesky =
-        n >= CHOLESKY_CENTRES && directions.len() == 3 && spread_ratios(q)[0] >= CHOLESKY_MIN_SPREAD;
+    let cholesky = method == Method::Fastest
+        && n >= CHOLESKY_CENTRES
+        && directions.len() == 3
+        && spread_ratios(q)[0] >= CHOLESKY_MIN_SPREAD;
     let par = cpd_solve::parallelism(n);
     let (q, directions) = (q.to_vec(), directions.to_vec());
-    move || {
+    let solve = move || {
         if !cholesky {
             return symmetric_solve(a, rhs);
         }
@@ -85,7 +99,8 @@ pub(super) fn solver(
             // whole system (the matrix was used up, so it is built again).
             None => symmetric_solve(matrix(&q, kernel, &directions), rhs),
         }
-    }
+    };
+    (cholesky, solve)
 }
 
 /// Dense symmetric-indefinite solve: Bunch–Kaufman LBLᵀ (half the flops of LU, pivoted, so the

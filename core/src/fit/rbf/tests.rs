@@ -140,3 +140,44 @@ fn duplicate_and_coplanar_centres_are_rejected() {
     assert_eq!(check_centres(&c[..3]), Err(Degenerate::TooFew(3)));
     assert!(Rbf::fit(&flat, &flat, Kernel::Linear, "x").is_err());
 }
+
+/// 600 centres on a sphere (`sphere_data`) with centre 400 moved to `gap` × the diagonal from
+/// centre 100 and its value 0.5 from centre 100's: two centres a hair apart going to distant
+/// values, as two feet on either side of a twisted bunny's ear.
+fn hair_apart(gap: f64) -> (Vec<Point3>, Vec<Point3>) {
+    let (mut c, mut v) = sphere_data(600);
+    v[400] = [v[100][0] + 0.5, v[100][1], v[100][2]];
+    let diag = Aabb::of(&c).map(|b| b.diagonal()).unwrap_or(1.0);
+    c[400] = [c[100][0] + gap * diag, c[100][1], c[100][2]];
+    (c, v)
+}
+
+#[test]
+fn a_system_the_cholesky_solves_too_roughly_is_solved_by_the_lblt() {
+    let (c, v) = hair_apart(GAP);
+    let bb = Aabb::of(&c).expect("centres");
+    let (origin, scale) = (bb.center(), bb.diagonal() / 2.0);
+    let q: Vec<Point3> = c.iter().map(|p| [0, 1, 2].map(|k| (p[k] - origin[k]) / scale)).collect();
+    let axes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let mut rhs = Mat::<f64>::zeros(604, 3);
+    for i in 0..600 {
+        for k in 0..3 {
+            rhs[(i, k)] = v[i][k];
+        }
+    }
+    let bound = 1e-6 * v.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
+    // The precondition: the null-space Cholesky is taken here and misses the guard's bound.
+    let a = system::matrix(&q, Kernel::Linear, &axes);
+    let (cholesky, solve) = system::solver(a, rhs, &q, Kernel::Linear, &axes, system::Method::Fastest);
+    assert!(cholesky);
+    let rough = Solved::new(solve().expect("solve"), 600, &q, &v, Kernel::Linear, origin, scale, &axes);
+    assert!(!rough.within(bound), "Cholesky residual {:.3e} within {bound:.3e}", rough.residual);
+    // The fit falls back to the LBLᵀ and interpolates every centre, the close pair included.
+    let f = Rbf::fit(&c, &v, Kernel::Linear, "test").expect("fit");
+    for (p, want) in c.iter().zip(&v) {
+        let got = f.eval(*p);
+        assert!(crate::geometry::dist(got, *want) <= 10.0 * bound, "{got:?} vs {want:?}");
+    }
+}
+
+const GAP: f64 = 5e-9;

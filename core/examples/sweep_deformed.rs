@@ -1,0 +1,178 @@
+//! Sweep (by hand, not in CI) of the fit on a realistic use: each shared mesh, repaired and in the
+//! unit box, fitted to its own plane sections (the sweep's planes) carried by a smooth non-rigid
+//! deformation: none ("ident"), `testdata::bend`, or a twist of 0.7 rad per unit length with an
+//! anisotropic scale ("twist"); the deformation keeps the topology, so the truth is the
+//! deformed template and its section regions are the template's. Alignment automatic, or 12
+//! user pairs at section crossings (`testdata::crossing_pairs`, as `bench_fit`). Prints the
+//! report's flips, edges and regions and, counted here against the truth: `against`, output faces
+//! whose normal opposes the closest truth face's (meaningful only where `dev` is small: a part
+//! displaced by more than its thickness meets the other side), and `dev`, the largest distance
+//! of an output vertex to the truth surface. "ok" is the job's own bar: 0 flipped faces and every
+//! segment an edge chain (`against` is shown, not judged: a few faces at creases or thin parts
+//! are against the truth even on the undeformed rows, where the fit is all but exact).
+//!
+//! `cargo run --release -p meshwork-core --example sweep_deformed [NAME-SUBSTRING]`
+use std::time::Instant;
+
+use meshwork_core::fit::testdata::{
+    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box,
+};
+use meshwork_core::geometry::{dot, triangle_cross};
+use meshwork_core::io::{read, ReadOptions};
+use meshwork_core::job::{self, JobKind};
+use meshwork_core::mesh::{Faces, Point3};
+use meshwork_core::repair::{self, RepairParams};
+use meshwork_core::spatial::Bvh;
+use meshwork_core::Progress;
+
+fn twist(p: Point3) -> Point3 {
+    let (x, y, z) = (p[0] - 0.5, p[1] - 0.5, p[2] - 0.5);
+    let a = 0.7 * x;
+    let (c, s) = (a.cos(), a.sin());
+    [0.5 + 1.2 * x, 0.5 + 0.85 * (c * y - s * z), 0.5 + 0.85 * (s * y + c * z)]
+}
+
+fn main() {
+    let filter = std::env::args().nth(1).unwrap_or_default();
+    let names = [
+        "spot",
+        "cow",
+        "homer",
+        "fandisk",
+        "rocker-arm",
+        "teapot",
+        "suzanne",
+        "beetle",
+        "alligator",
+        "woody",
+        "stanford-bunny",
+    ];
+    let deforms: [(&str, fn(Point3) -> Point3); 3] =
+        [("ident", |p| p), ("bend", |p| bend(p, 1.0)), ("twist", twist)];
+    for name in names {
+        let Ok(bytes) = std::fs::read(format!("../shared/meshes/{name}.obj")) else { continue };
+        let raw = read(&bytes, &ReadOptions { name_hint: Some("x.obj".into()), ..Default::default() })
+            .expect("read")
+            .mesh;
+        let params = RepairParams { fill_holes: false, ..Default::default() };
+        let mut t = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
+        to_unit_box(&mut t);
+        for (dname, d) in deforms {
+            for align in ["auto", "pairs"] {
+                let label = format!("{name} vs {dname}ed self ({align})");
+                if !label.contains(&filter) {
+                    continue;
+                }
+                let mut truth = t.clone();
+                truth.positions = t.positions.iter().map(|&p| d(p)).collect();
+                // Sections of the template carried by the deformation (curved, not planar), as
+                // bench_fit builds its case: the regions are the template's.
+                let planes = sweep_planes(&t);
+                let sections = plane_sections(&t, &planes);
+                let want = section_regions(&t, &planes);
+                let mut curves = sections.clone();
+                curves.positions = sections.positions.iter().map(|&p| d(p)).collect();
+                // Flat meshes (alligator, woody) have coplanar sections: the in-plane polynomial.
+                let p = if align == "auto" {
+                    serde_json::json!({ "coplanar_centres": "augment" })
+                } else {
+                    serde_json::json!({ "coplanar_centres": "augment", "pairs": crossing_pairs(&sections, &t, 12, d) })
+                };
+                let clock = Instant::now();
+                let out = job::run(JobKind::Fit, vec![t.clone(), curves], p, &Progress::new());
+                let secs = clock.elapsed().as_secs_f64();
+                match out {
+                    Err(e) => println!("{label:<40} {secs:6.2}s ERROR {e}"),
+                    Ok(o) => {
+                        let m = &o.meshes[0];
+                        let r = &o.report;
+                        // Against the truth: the normal of the closest truth face at each output
+                        // face's centroid; distance: each output vertex to the truth surface.
+                        let tt = truth.faces.triangles();
+                        let bvh = Bvh::new(&truth.positions, &Faces::from_triangles(&tt));
+                        let mut against = 0;
+                        for f in m.faces.triangles() {
+                            let q = |i: usize| m.positions[f[i] as usize];
+                            let c = [0, 1, 2].map(|k| (q(0)[k] + q(1)[k] + q(2)[k]) / 3.0);
+                            if let Some(h) = bvh.closest(c) {
+                                let g = |i: usize| truth.positions[tt[h.face as usize][i] as usize];
+                                if dot(triangle_cross(q(0), q(1), q(2)), triangle_cross(g(0), g(1), g(2)))
+                                    < 0.0
+                                {
+                                    against += 1;
+                                }
+                            }
+                        }
+                        let dev = m
+                            .positions
+                            .iter()
+                            .map(|&q| bvh.closest(q).map_or(0.0, |h| h.dist2.sqrt()))
+                            .fold(0.0, f64::max);
+                        if std::env::var("SWEEP_DETAIL").is_ok() {
+                            eprintln!(
+                                "  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",
+                                r["untangle"], r["cleanup"], r["retriangulation"], r["folds"]
+                            );
+                        }
+                        if std::env::var("SWEEP_FOLDS").is_ok() {
+                            print_folds(m);
+                        }
+                        let ok = r["flipped_faces"] == 0 && r["segments_as_edges"] == 1.0;
+                        println!(
+                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {}",
+                            if ok { "ok " } else { "BAD" },
+                            r["flipped_faces"],
+                            r["flipped_faces_after_fine"],
+                            r["flipped_faces_before_smoothing"],
+                            r["segments_as_edges"].as_f64().unwrap_or(0.0),
+                            r["regions"],
+                            r["folded_edges"],
+                            r["alignment"]["ambiguous"],
+                            r["retriangulation"]["failed_pieces"],
+                            r["retriangulation"]["off_surface_segments"],
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Diagnostic (`SWEEP_FOLDS=1`): every pair of faces on an edge whose normals are over 150°
+/// apart, with their corners, which of them are on output curve chains, and the positions.
+fn print_folds(m: &meshwork_core::mesh::Mesh) {
+    use std::collections::HashMap;
+    let tris = m.faces.triangles();
+    let on_curve: std::collections::HashSet<u32> = m.curves.iter().flatten().copied().collect();
+    let mut by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (f, t) in tris.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let n = |f: usize| {
+        let t = tris[f];
+        triangle_cross(m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize])
+    };
+    for (e, fs) in &by_edge {
+        if fs.len() != 2 {
+            continue;
+        }
+        let (a, b) = (n(fs[0]), n(fs[1]));
+        let c = dot(a, b) / (dot(a, a) * dot(b, b)).sqrt();
+        if c < (150f64).to_radians().cos() {
+            let mark = |v: u32| format!("{v}{}", if on_curve.contains(&v) { "*" } else { "" });
+            eprintln!(
+                "  fold edge {e:?} cos {c:.6} faces {:?} {:?} / {:?} {:?}",
+                fs[0],
+                tris[fs[0]].map(mark),
+                fs[1],
+                tris[fs[1]].map(mark)
+            );
+            for v in tris[fs[0]].iter().chain(&tris[fs[1]]) {
+                eprintln!("    v{v} {:?}", m.positions[*v as usize]);
+            }
+        }
+    }
+}
