@@ -57,8 +57,16 @@ fn automatic_alignment_follows_a_bend_better_than_any_similarity() {
         *p = sim.apply(*p);
     }
     let rigid = rms(&pos, &truth);
-    let w =
-        align::warp_icp(&mut pos, &tris, &net.points, 0.0 /* no trim floor */, 30, &Progress::new()).unwrap();
+    let w = align::warp_icp(
+        &mut pos,
+        &tris,
+        &net.points,
+        0.0, /* no trim floor */
+        None,
+        30,
+        &Progress::new(),
+    )
+    .unwrap();
     let warped = rms(&pos, &truth);
     eprintln!("similarity floor {floor:.4}, ICP {rigid:.4}, warp {warped:.4} ({w:?})");
     assert!(rigid < 1.5 * floor, "the ICP lands near the best similarity: {rigid} vs {floor}");
@@ -107,6 +115,7 @@ fn the_warp_does_not_chase_a_templates_faceting() {
         &fan_triangles(&m.faces),
         &net.points,
         median_segment,
+        None,
         30,
         &Progress::new(),
     )

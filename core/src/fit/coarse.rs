@@ -149,10 +149,18 @@ fn automatic(
     net: &curves::CurveNetwork,
     progress: &Progress,
 ) -> Result<CoarseReport> {
-    let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
     let rim = Rim::new(tris, net, progress)?;
+    // The ends' rim matches only for curves in one plane ([`PLANAR_CURVES`]).
+    let no_ends: Vec<Point3> = Vec::new();
+    let planar = rbf::spread_ratios(&net.points)[0] < PLANAR_CURVES;
+    let ends =
+        align::RimEnds { edges: &rim.edges, ends: if planar { &rim.ends } else { &no_ends }, cap: rim.cap };
+    let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
     let mut tried: Vec<(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)> =
         Vec::new();
+    // The contenders' scores with the warp of the curve points alone, when the rim term changes
+    // anything ([`plain_scores`]).
+    let plain = if planar { plain_scores(pos, tris, net, &rim, &candidates, progress)? } else { Vec::new() };
     for c in candidates {
         let warped = if c.contender {
             let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
@@ -161,6 +169,7 @@ fn automatic(
                 tris,
                 &net.points,
                 super::approach::median_segment(net),
+                Some(&ends),
                 WARP_ITERATIONS,
                 progress,
             )?;
@@ -191,7 +200,9 @@ fn automatic(
         })
         .collect();
     let runner_up = tried.get(1).map(score).unwrap_or(f64::INFINITY);
-    let close_score = runner_up <= AMBIGUOUS_RATIO * best;
+    // Close scores, by this warp or by the warp without the rim matches ([`plain_scores`]).
+    let close_score =
+        runner_up <= AMBIGUOUS_RATIO * best || (plain.len() > 1 && plain[1] <= AMBIGUOUS_RATIO * plain[0]);
     // The two terms of the score can disagree: a pose turned far from the chosen one whose warp
     // fits the curves much closer, losing only on the curve ends' gap to the rim. A flat open
     // template (the alligator fitted to its own sections) was turned over that way, every output
@@ -235,6 +246,50 @@ fn automatic(
         warning,
     })
 }
+
+/// The contenders' scores (as in [`automatic`]) after the warp without the curve ends' rim
+/// matches, best first; empty when the template has no rim or the network no ends (the warp is
+/// then the same; the caller skips it for curves off one plane, which get no rim matches). Why: the rim matches let one pose's warp follow the curves far better than
+/// another's, also when every contender is wrong: woody's bent sections (`fit_align.rs`), whose
+/// contenders are all turned 40–180° from the truth, scored 1.35× apart with them and within
+/// 1.25× without. An ambiguity either warp sees is reported (session 12, fit-raw).
+fn plain_scores(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    rim: &Rim,
+    candidates: &[align::Candidate],
+    progress: &Progress,
+) -> Result<Vec<f64>> {
+    if rim.edges.is_empty() || rim.ends.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut scores = Vec::new();
+    for c in candidates.iter().filter(|c| c.contender) {
+        let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
+        let w = align::warp_icp(
+            &mut p,
+            tris,
+            &net.points,
+            super::approach::median_segment(net),
+            None,
+            WARP_ITERATIONS,
+            progress,
+        )?;
+        scores.push((w.rms_all_after.powi(2) + rim.end_gap(&p).unwrap_or(0.0).powi(2)).sqrt());
+    }
+    scores.sort_by(f64::total_cmp);
+    Ok(scores)
+}
+
+/// Curves whose smallest spread is under this share of the largest lie in one plane: the warp then
+/// matches their ends to the rim ([`align::RimEnds`]). Why only then: curves in the plane of a flat
+/// template lie on it wherever it sits in that plane, every closest-point match is ~0 and only the
+/// ends tell the pose (woody and alligator raw under their own sections). Curves off that plane
+/// (sweep_fit's bent sections of the same meshes) do carry normal distances; there the rim matches
+/// moved woody's row, whose every contender is a wrong pose, from 10 to 9 of 11 regions at every
+/// weight tried (1/10–1/3) (session 12, fit-raw).
+const PLANAR_CURVES: f64 = 1e-3;
 
 /// Each curve end's gap to the rim is capped at this × the curves' bounding-box diagonal (see
 /// [`automatic`]).
@@ -329,6 +384,7 @@ fn pairs_similarity(
         tris,
         &net.points,
         super::approach::median_segment(net),
+        None,
         WARP_ITERATIONS,
         progress,
     )?;

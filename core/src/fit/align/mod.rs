@@ -12,7 +12,7 @@ use crate::mesh::Point3;
 use super::kdtree::KdTree;
 
 mod warp;
-pub use warp::{warp_icp, WarpReport};
+pub use warp::{warp_icp, RimEnds, WarpReport};
 
 /// Eigen-decomposition of a small symmetric matrix (row-major `n×n`), as
 /// [`crate::register::symmetric_eigen`] computes it, with the eigenvectors laid out as columns

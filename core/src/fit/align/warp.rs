@@ -25,6 +25,58 @@ pub struct WarpReport {
     pub damped: u32,
 }
 
+/// The template's rim (its boundary edges) and the curve ends (network degree 1) within `cap` of
+/// it, for the warp: sections of an open surface end on its boundary, and on a flat template
+/// those ends are all that fixes the template's place *in* its plane. Every curve point inside the
+/// outline lies on the surface wherever the template sits, so its trimmed match (distance ~0)
+/// only holds the warp still; measured on woody and alligator as read (raw, flat) under their
+/// own sections: the right pose's warp kept the similarity's wrong scale (0.90 and 1.23), its
+/// ends stayed 0.018–0.024 off the rim, and the mirror pose won (session 12, fit-raw).
+pub struct RimEnds<'a> {
+    pub edges: &'a [(u32, u32)],
+    pub ends: &'a [Point3],
+    pub cap: f64,
+}
+
+impl RimEnds<'_> {
+    /// (closest rim point, end) for every end within `cap` of the rim, the template's vertices
+    /// placed by `at`.
+    fn matches(&self, mut at: impl FnMut(u32) -> Point3) -> Vec<(Point3, Point3)> {
+        if self.edges.is_empty() {
+            return Vec::new();
+        }
+        let segs: Vec<(Point3, Point3)> = self.edges.iter().map(|&(a, b)| (at(a), at(b))).collect();
+        self.ends
+            .iter()
+            .filter_map(|&e| {
+                let best = segs
+                    .iter()
+                    .map(|&(a, b)| closest_on_segment(e, a, b))
+                    .min_by(|x, y| norm2(sub(*x, e)).total_cmp(&norm2(sub(*y, e))))?;
+                (norm2(sub(best, e)) <= self.cap * self.cap).then_some((best, e))
+            })
+            .collect()
+    }
+}
+
+/// The curve ends' matches to the rim weigh this share of the kept curve points' in all. Measured
+/// (session 12, fit-raw; the woody and alligator raw rows of `sweep_unseen`, the flat rows of
+/// `sweep_fit`): 1/8 to 1/3 fit both raw meshes without flips; at 1/12 or 1 the alligator keeps
+/// flips; sweep_fit's woody row, which no weight brings out of its mirror pose, moves by a region,
+/// a flip or a segment either way across the whole range (1/8 leaves it as it was).
+const END_WEIGHT: f64 = 0.125;
+
+/// The point of segment a–b closest to `p`.
+fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
+    let ab = sub(b, a);
+    let l2 = norm2(ab);
+    if l2 <= 0.0 {
+        return a;
+    }
+    let t = (crate::geometry::dot(sub(p, a), ab) / l2).clamp(0.0, 1.0);
+    add(a, scale(ab, t))
+}
+
 /// Matches within this many curve segments (the median) of the surface are never trimmed.
 ///
 /// Why: the trim is for curves running off the template, and its cut (2.5 × the median distance)
@@ -114,11 +166,14 @@ fn solve_spd(a: &[f64], b: &[[f64; 3]], n: usize) -> Option<Vec<[f64; 3]>> {
 /// faceting, measured once on the template as given to the warp); every coefficient is pulled towards
 /// zero by a ridge term, the quadratic ones harder, so directions the curves do not determine
 /// (all curves on one plane) stay put; a step that would fold faces is halved (then stops).
+/// `rim`: the template's rim and the curve ends near it, matched to it in every iteration
+/// ([`RimEnds`]; `None` leaves them out).
 pub fn warp_icp(
     pos: &mut [Point3],
     tris: &[[u32; 3]],
     points: &[Point3],
     spacing: f64,
+    rim: Option<&RimEnds>,
     iterations: u32,
     progress: &Progress,
 ) -> Result<WarpReport> {
@@ -170,22 +225,39 @@ pub fn warp_icp(
                 report.rms_before = rms;
                 first = false;
             }
-            if rms > 0.999 * last_rms || keep.len() < 10 {
+            // Curve ends near the rim, matched to it, weighing [`END_WEIGHT`] of the kept curve
+            // points in all ([`RimEnds`]); none on a closed template or a network without ends.
+            let ends = rim.map_or_else(Vec::new, |r| r.matches(|v| warp.at(v)));
+            let end_weight =
+                if ends.is_empty() { 0.0 } else { END_WEIGHT * keep.len() as f64 / ends.len() as f64 };
+            let objective = if ends.is_empty() {
+                rms
+            } else {
+                let e2: f64 = ends.iter().map(|(f, e)| norm2(sub(*e, *f))).sum();
+                // The weighted RMS of both kinds of matches.
+                let n = keep.len() as f64 + end_weight * ends.len() as f64;
+                ((rms * rms * keep.len() as f64 + end_weight * e2) / n).sqrt()
+            };
+            if objective > 0.999 * last_rms || keep.len() < 10 {
                 break;
             }
-            last_rms = rms;
+            last_rms = objective;
             let n = monomials([0.0; 3], degree).1;
             let mut a = vec![0.0; n * n];
             let mut b = vec![[0.0; 3]; n];
-            for &i in &keep {
-                let (m, _) = monomials(warp.u(feet[i].1), degree);
-                let r = sub(points[which[i] as usize], feet[i].1);
+            let rows = keep
+                .iter()
+                .map(|&i| (feet[i].1, points[which[i] as usize], 1.0))
+                .chain(ends.iter().map(|&(f, e)| (f, e, end_weight)));
+            for (foot, target, weight) in rows {
+                let (m, _) = monomials(warp.u(foot), degree);
+                let r = sub(target, foot);
                 for j in 0..n {
                     for k in 0..n {
-                        a[j * n + k] += m[j] * m[k];
+                        a[j * n + k] += weight * m[j] * m[k];
                     }
                     for c in 0..3 {
-                        b[j][c] += m[j] * r[c];
+                        b[j][c] += weight * m[j] * r[c];
                     }
                 }
             }
