@@ -236,13 +236,13 @@ fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
 }
 
 /// A flat open figure fitted to its own sections (the alligator, repaired, holes left open): the
-/// template already lies on the curves, yet the automatic alignment's score preferred the pose
-/// turned over (the curve ends' gap to the rim outweighed a warp 6× closer to the curves), and
-/// every output face came out against the truth without a word. Invariant (truth: the template
-/// itself): an output turned over — most faces against the closest template face — must be
-/// reported as ambiguous.
+/// template already lies on the curves. Before the warp matched curve ends to the rim (fit-raw,
+/// session 12) the automatic alignment chose the pose turned over (the end gap outweighed a warp
+/// 6× closer to the curves) and 6,698 of 6,702 output faces came out against the truth, with the
+/// report not calling the alignment ambiguous. Truth: the template itself; at most 1% of the
+/// output faces may face against the closest template face.
 #[test]
-fn a_turned_over_result_is_never_silent() {
+fn a_flat_figure_under_its_own_sections_keeps_its_side_up() {
     use meshwork_core::geometry::{dot, triangle_cross};
     use meshwork_core::mesh::Faces;
     use meshwork_core::repair::{self, RepairParams};
@@ -269,15 +269,6 @@ fn a_turned_over_result_is_never_silent() {
             })
         })
         .count();
-    let a = &out.report["alignment"];
-    eprintln!("{against} of {} faces against the truth; alignment {a}", tris.len());
-    if 2 * against > tris.len() {
-        assert_eq!(
-            a["ambiguous"],
-            true,
-            "turned over ({against} of {} faces) and not reported: {a}",
-            tris.len()
-        );
-        assert!(a["warning"].as_str().is_some_and(|w| w.contains("pairs")), "{a}");
-    }
+    eprintln!("{against} of {} faces against the truth; alignment {}", tris.len(), out.report["alignment"]);
+    assert!(100 * against <= tris.len(), "{against} of {} faces turned over", tris.len());
 }

@@ -29,10 +29,8 @@ pub struct CoarseReport {
     pub candidates: Vec<CandidateReport>,
     /// `pca_icp`: the runner-up pose fits the curves about as well as the chosen one
     /// (score within [`AMBIGUOUS_RATIO`]) although it is turned far from it: typical of a
-    /// nearly symmetric template (a flat figure and its mirror image). Or a pose turned more
-    /// than [`DISAGREE_ANGLE_DEG`] fits the curves much closer after its warp
-    /// ([`DISAGREE_WARP_RATIO`]) and lost only on the curve ends' gap to the rim. The result may
-    /// be the wrong one of the two; give pairs.
+    /// nearly symmetric template (a flat figure and its mirror image). The result may be the
+    /// wrong one of the two; give pairs.
     pub ambiguous: bool,
     /// Why `ambiguous` is set, in words, for the user.
     pub warning: Option<String>,
@@ -58,13 +56,6 @@ pub struct CandidateReport {
 /// A runner-up whose score is within this factor of the winner's makes the choice ambiguous
 /// (see [`CoarseReport::ambiguous`]).
 pub const AMBIGUOUS_RATIO: f64 = 1.25;
-
-/// A pose turned more than this from the chosen one ([`DISAGREE_WARP_RATIO`])…
-pub const DISAGREE_ANGLE_DEG: f64 = 90.0;
-
-/// …whose warp ends under this fraction of the chosen pose's RMS distance to the curves makes
-/// the choice ambiguous too, whatever the end gaps (see [`CoarseReport::ambiguous`]).
-pub const DISAGREE_WARP_RATIO: f64 = 0.5;
 
 impl CoarseReport {
     /// (curve point, template vertex) of every user pair, the points the later stages hold fixed.
@@ -200,41 +191,16 @@ fn automatic(
         })
         .collect();
     let runner_up = tried.get(1).map(score).unwrap_or(f64::INFINITY);
-    // Close scores, by this warp or by the warp without the rim matches ([`plain_scores`]).
-    let close_score =
+    let ambiguous =
         runner_up <= AMBIGUOUS_RATIO * best || (plain.len() > 1 && plain[1] <= AMBIGUOUS_RATIO * plain[0]);
-    // The two terms of the score can disagree: a pose turned far from the chosen one whose warp
-    // fits the curves much closer, losing only on the curve ends' gap to the rim. A flat open
-    // template (the alligator fitted to its own sections) was turned over that way, every output
-    // face against the truth, and nothing said so.
-    let closer_fit = tried.iter().zip(&candidates).skip(1).find(|((_, w), c)| {
-        c.angle_deg > DISAGREE_ANGLE_DEG
-            && w.as_ref().is_some_and(|w| w.1.rms_all_after < DISAGREE_WARP_RATIO * warp.rms_all_after)
-    });
-    let ambiguous = close_score || closer_fit.is_some();
-    let warning = if close_score {
-        Some(format!(
+    let warning = ambiguous.then(|| {
+        format!(
             "automatic alignment is ambiguous: a pose turned {:.0}° from the chosen one fits the curves almost \
              as well (score {:.3e} vs {:.3e}); the template may be placed the wrong way round (e.g. as its \
              mirror image): give correspondence pairs",
             candidates[1].angle_deg, runner_up, best
-        ))
-    } else {
-        closer_fit.map(|((_, w), c)| {
-            let (other_rms, other_gap) = w.as_ref().map_or((f64::NAN, None), |w| (w.1.rms_all_after, w.3));
-            format!(
-                "automatic alignment is ambiguous: a pose turned {:.0}° from the chosen one fits the curves \
-                 closer (warp rms {:.3e} vs {:.3e}) and was rejected only for where the curve ends meet the \
-                 template's rim (end gap {:.3e} vs {:.3e}); the template may be placed the wrong way round \
-                 (e.g. turned over): give correspondence pairs",
-                c.angle_deg,
-                other_rms,
-                warp.rms_all_after,
-                other_gap.unwrap_or(0.0),
-                candidates[0].end_gap.unwrap_or(0.0)
-            )
-        })
-    };
+        )
+    });
     Ok(CoarseReport {
         method: "pca_icp",
         pair_curve_points: vec![],
