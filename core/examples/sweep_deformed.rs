@@ -15,14 +15,13 @@
 use std::time::Instant;
 
 use meshwork_core::fit::testdata::{
-    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box,
+    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box, TruthSurface,
 };
 use meshwork_core::geometry::{dot, triangle_cross};
 use meshwork_core::io::{read, ReadOptions};
 use meshwork_core::job::{self, JobKind};
-use meshwork_core::mesh::{Faces, Point3};
+use meshwork_core::mesh::Point3;
 use meshwork_core::repair::{self, RepairParams};
-use meshwork_core::spatial::Bvh;
 use meshwork_core::Progress;
 
 fn twist(p: Point3) -> Point3 {
@@ -88,26 +87,9 @@ fn main() {
                         let r = &o.report;
                         // Against the truth: the normal of the closest truth face at each output
                         // face's centroid; distance: each output vertex to the truth surface.
-                        let tt = truth.faces.triangles();
-                        let bvh = Bvh::new(&truth.positions, &Faces::from_triangles(&tt));
-                        let mut against = 0;
-                        for f in m.faces.triangles() {
-                            let q = |i: usize| m.positions[f[i] as usize];
-                            let c = [0, 1, 2].map(|k| (q(0)[k] + q(1)[k] + q(2)[k]) / 3.0);
-                            if let Some(h) = bvh.closest(c) {
-                                let g = |i: usize| truth.positions[tt[h.face as usize][i] as usize];
-                                if dot(triangle_cross(q(0), q(1), q(2)), triangle_cross(g(0), g(1), g(2)))
-                                    < 0.0
-                                {
-                                    against += 1;
-                                }
-                            }
-                        }
-                        let dev = m
-                            .positions
-                            .iter()
-                            .map(|&q| bvh.closest(q).map_or(0.0, |h| h.dist2.sqrt()))
-                            .fold(0.0, f64::max);
+                        let surface = TruthSurface::new(&truth);
+                        let against = surface.faces_against(m);
+                        let dev = surface.max_distance(m);
                         if std::env::var("SWEEP_DETAIL").is_ok() {
                             eprintln!(
                                 "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",

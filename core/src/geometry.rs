@@ -43,6 +43,15 @@ pub fn dist(a: Point3, b: Point3) -> f64 {
     norm(sub(a, b))
 }
 
+/// The point of segment a–b closest to `p` (`a` for a zero-length segment).
+#[inline]
+pub fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
+    let ab = sub(b, a);
+    let l2 = dot(ab, ab);
+    let t = if l2 > 0.0 { (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    add(a, scale(ab, t))
+}
+
 /// `a` scaled to unit length, or zero when `a` is (numerically) zero.
 #[inline]
 pub fn normalize(a: Point3) -> Point3 {

@@ -243,10 +243,8 @@ fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
 /// output faces may face against the closest template face.
 #[test]
 fn a_flat_figure_under_its_own_sections_keeps_its_side_up() {
-    use meshwork_core::geometry::{dot, triangle_cross};
-    use meshwork_core::mesh::Faces;
+    use meshwork_core::fit::testdata::TruthSurface;
     use meshwork_core::repair::{self, RepairParams};
-    use meshwork_core::spatial::Bvh;
     let params = RepairParams { fill_holes: false, ..Default::default() };
     let mut m = repair::run(shared("alligator"), &params, &Progress::new()).expect("repair").meshes.remove(0);
     to_unit_box(&mut m);
@@ -254,21 +252,9 @@ fn a_flat_figure_under_its_own_sections_keeps_its_side_up() {
     let fit_params =
         FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
     let out = run(vec![m.clone(), curves], &fit_params, &Progress::new()).expect("fit");
-    let truth = m.faces.triangles();
-    let bvh = Bvh::new(&m.positions, &Faces::from_triangles(&truth));
     let o = &out.meshes[0];
     let tris = o.faces.triangles();
-    let against = tris
-        .iter()
-        .filter(|t| {
-            let q = |k: usize| o.positions[t[k] as usize];
-            let c = [0, 1, 2].map(|k| (q(0)[k] + q(1)[k] + q(2)[k]) / 3.0);
-            bvh.closest(c).is_some_and(|h| {
-                let g = |k: usize| m.positions[truth[h.face as usize][k] as usize];
-                dot(triangle_cross(q(0), q(1), q(2)), triangle_cross(g(0), g(1), g(2))) < 0.0
-            })
-        })
-        .count();
+    let against = TruthSurface::new(&m).faces_against(o);
     eprintln!("{against} of {} faces against the truth; alignment {}", tris.len(), out.report["alignment"]);
     assert!(100 * against <= tris.len(), "{against} of {} faces turned over", tris.len());
 }

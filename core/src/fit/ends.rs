@@ -11,7 +11,7 @@
 
 use std::collections::HashSet;
 
-use crate::geometry::{add, dist, dot, scale, sub};
+use crate::geometry::{closest_on_segment, dist};
 use crate::mesh::Point3;
 
 use super::curves::CurveNetwork;
@@ -61,16 +61,6 @@ pub fn boundary_feet(
             (distance <= max_distance).then_some(BoundaryFoot { point_index: p, face, foot, distance })
         })
         .collect()
-}
-
-fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
-    if l2 <= 0.0 {
-        return a;
-    }
-    let t = (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0);
-    add(a, scale(ab, t))
 }
 
 #[cfg(test)]

@@ -48,7 +48,7 @@ pub mod untangle;
 pub mod uvs;
 
 use crate::error::{Error, Result};
-use crate::geometry::{add, dist, scale, sub, Aabb};
+use crate::geometry::{add, dist, scale, Aabb};
 use crate::job::{Output, Progress, Stages};
 use crate::mesh::{Faces, Mesh, Point3};
 
@@ -601,8 +601,5 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
 /// Distance helper kept here for the report.
 pub(crate) fn point_segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
-    let ab = sub(b, a);
-    let l2 = crate::geometry::norm2(ab);
-    let t = if l2 > 0.0 { (crate::geometry::dot(sub(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    dist(p, add(a, crate::geometry::scale(ab, t)))
+    dist(p, crate::geometry::closest_on_segment(p, a, b))
 }

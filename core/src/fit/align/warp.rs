@@ -3,7 +3,7 @@
 //! to its last step that folds no face.
 
 use crate::error::{Error, Result};
-use crate::geometry::{add, dist, dot, norm2, scale, sub};
+use crate::geometry::{add, closest_on_segment, dist, dot, norm2, scale, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -65,17 +65,6 @@ impl RimEnds<'_> {
 /// flips; sweep_fit's woody row, which no weight brings out of its mirror pose, moves by a region,
 /// a flip or a segment either way across the whole range (1/8 leaves it as it was).
 const END_WEIGHT: f64 = 0.125;
-
-/// The point of segment a–b closest to `p`.
-fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
-    let ab = sub(b, a);
-    let l2 = norm2(ab);
-    if l2 <= 0.0 {
-        return a;
-    }
-    let t = (crate::geometry::dot(sub(p, a), ab) / l2).clamp(0.0, 1.0);
-    add(a, scale(ab, t))
-}
 
 /// Matches within this many curve segments (the median) of the surface are never trimmed.
 ///

@@ -251,23 +251,26 @@ impl Rbf {
                 rhs[(i, k)] = values[i][k];
             }
         }
-        let solve = |method: system::Method| -> Result<(bool, Mat<f64>)> {
+        let solve = |method: system::Method| -> Result<(Mat<f64>, system::Factorisation)> {
             let a = system::matrix(&q, kernel, directions);
-            let (cholesky, solve) = system::solver(a, rhs.clone(), &q, kernel, directions, method);
-            let x = if n >= INTERRUPTIBLE_CENTRES { interruptible(progress, solve)?? } else { solve()? };
-            Ok((cholesky, x))
+            let solve = system::solver(a, rhs.clone(), &q, kernel, directions, method);
+            if n >= INTERRUPTIBLE_CENTRES {
+                interruptible(progress, solve)?
+            } else {
+                solve()
+            }
         };
-        let (cholesky, x) = solve(system::Method::Fastest)?;
+        let frame = Frame { q: &q, values, kernel, origin, scale, directions };
+        let (x, factorisation) = solve(system::Method::Fastest)?;
         // Residual guard: an ill-conditioned system shows up here rather than as a silent misfit.
         // The null-space Cholesky loses more digits than the pivoted LBLᵀ on a near-singular
         // system (a twisted bunny's feet 2.5e-8 of the diagonal apart going to points 3.7e-3
         // apart: residual 7.8e-6 with the Cholesky, under the bound with the LBLᵀ), so a failed
         // guard after the Cholesky is retried with the LBLᵀ before it is an error.
         let bound = 1e-6 * values.iter().flat_map(|v| v.iter()).fold(0.0f64, |m, c| m.max(c.abs())).max(1.0);
-        let mut fitted = Solved::new(x, n, &q, values, kernel, origin, scale, directions);
-        if cholesky && !fitted.within(bound) {
-            let (_, x) = solve(system::Method::Pivoted)?;
-            fitted = Solved::new(x, n, &q, values, kernel, origin, scale, directions);
+        let mut fitted = frame.solved(x);
+        if factorisation == system::Factorisation::NullSpaceCholesky && !fitted.within(bound) {
+            fitted = frame.solved(solve(system::Method::Pivoted)?.0);
         }
         if !fitted.within(bound) {
             return Err(Error::numerical(
@@ -422,27 +425,24 @@ pub const INTERRUPTIBLE_CENTRES: usize = 500;
 #[cfg(test)]
 mod tests;
 
-/// A solution of the interpolation system as a field, with the largest entry of its residual.
-struct Solved {
-    rbf: Rbf,
-    /// max |b − A x|, infinite when x or the residual is not finite.
-    residual: f64,
+/// The interpolation problem in the centres' normalised frame: what a solution vector is read
+/// against.
+struct Frame<'a> {
+    /// The centres, normalised (`(c − origin) / scale`).
+    q: &'a [Point3],
+    values: &'a [Point3],
+    kernel: Kernel,
+    origin: Point3,
+    scale: f64,
+    directions: &'a [Point3],
 }
 
-impl Solved {
-    /// `x`: rows α_1..α_n, then one per polynomial direction, then the constant.
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        x: Mat<f64>,
-        n: usize,
-        q: &[Point3],
-        values: &[Point3],
-        kernel: Kernel,
-        origin: Point3,
-        scale: f64,
-        directions: &[Point3],
-    ) -> Solved {
-        let nd = directions.len();
+impl Frame<'_> {
+    /// The field of solution `x` (rows α_1..α_n, then one per polynomial direction, then the
+    /// constant) with the largest entry of its residual.
+    fn solved(&self, x: Mat<f64>) -> Solved {
+        let (q, values, directions) = (self.q, self.values, self.directions);
+        let (n, nd) = (q.len(), directions.len());
         let col = |k: usize| (0..n).map(|i| x[(i, k)]).collect::<Vec<_>>();
         // The polynomial part as the rows x, y, z, 1 of a full affine map (Σ_k d_k ⊗ coefficient_k).
         let mut affine = [[0.0; 3]; 4];
@@ -457,9 +457,9 @@ impl Solved {
             affine[3][c] = x[(n + nd, c)];
         }
         let rbf = Rbf {
-            kernel,
-            origin,
-            scale,
+            kernel: self.kernel,
+            origin: self.origin,
+            scale: self.scale,
             in_plane: nd < 3,
             cx: q.iter().map(|p| p[0]).collect(),
             cy: q.iter().map(|p| p[1]).collect(),
@@ -492,7 +492,16 @@ impl Solved {
         let residual = if finite && rmax.is_finite() { rmax } else { f64::INFINITY };
         Solved { rbf, residual }
     }
+}
 
+/// A solution of the interpolation system as a field, with the largest entry of its residual.
+struct Solved {
+    rbf: Rbf,
+    /// max |b − A x|, infinite when x or the residual is not finite.
+    residual: f64,
+}
+
+impl Solved {
     fn within(&self, bound: f64) -> bool {
         self.residual <= bound
     }

@@ -70,10 +70,16 @@ pub(super) enum Method {
     Pivoted,
 }
 
+/// The factorisation that produced a solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Factorisation {
+    NullSpaceCholesky,
+    Lblt,
+}
+
 /// The solve of `a x = rhs` (a from [`matrix`] of the normalised centres `q`), to run on the
 /// job's thread or on one of its own. Which factorisation, and faer's parallelism, are decided
-/// here, on the calling thread ([`cpd_solve::parallelism`]). Also returns whether the
-/// null-space Cholesky is tried.
+/// here, on the calling thread ([`cpd_solve::parallelism`]); the solve returns the one used.
 pub(super) fn solver(
     a: Mat<f64>,
     rhs: Mat<f64>,
@@ -81,7 +87,7 @@ pub(super) fn solver(
     kernel: Kernel,
     directions: &[Point3],
     method: Method,
-) -> (bool, impl FnOnce() -> Result<Mat<f64>> + Send + 'static) {
+) -> impl FnOnce() -> Result<(Mat<f64>, Factorisation)> + Send + 'static {
     let n = q.len();
     let cholesky = method == Method::Fastest
         && n >= CHOLESKY_CENTRES
@@ -89,18 +95,18 @@ pub(super) fn solver(
         && spread_ratios(q)[0] >= CHOLESKY_MIN_SPREAD;
     let par = cpd_solve::parallelism(n);
     let (q, directions) = (q.to_vec(), directions.to_vec());
-    let solve = move || {
+    move || {
+        let lblt = |a, rhs| symmetric_solve(a, rhs).map(|x| (x, Factorisation::Lblt));
         if !cholesky {
-            return symmetric_solve(a, rhs);
+            return lblt(a, rhs);
         }
         match cpd_solve::solve(a, &rhs, n, kernel.definiteness_sign(), par) {
-            Some(x) => Ok(x),
+            Some(x) => Ok((x, Factorisation::NullSpaceCholesky)),
             // Not numerically definite on the null space: the pivoted indefinite solve of the
             // whole system (the matrix was used up, so it is built again).
-            None => symmetric_solve(matrix(&q, kernel, &directions), rhs),
+            None => lblt(matrix(&q, kernel, &directions), rhs),
         }
-    };
-    (cholesky, solve)
+    }
 }
 
 /// Dense symmetric-indefinite solve: Bunch–Kaufman LBLᵀ (half the flops of LU, pivoted, so the

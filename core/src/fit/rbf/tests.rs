@@ -168,9 +168,11 @@ fn a_system_the_cholesky_solves_too_roughly_is_solved_by_the_lblt() {
     let bound = 1e-6 * v.iter().flatten().fold(1.0f64, |m, x| m.max(x.abs()));
     // The precondition: the null-space Cholesky is taken here and misses the guard's bound.
     let a = system::matrix(&q, Kernel::Linear, &axes);
-    let (cholesky, solve) = system::solver(a, rhs, &q, Kernel::Linear, &axes, system::Method::Fastest);
-    assert!(cholesky);
-    let rough = Solved::new(solve().expect("solve"), 600, &q, &v, Kernel::Linear, origin, scale, &axes);
+    let (x, used) =
+        system::solver(a, rhs, &q, Kernel::Linear, &axes, system::Method::Fastest)().expect("solve");
+    assert_eq!(used, system::Factorisation::NullSpaceCholesky);
+    let frame = Frame { q: &q, values: &v, kernel: Kernel::Linear, origin, scale, directions: &axes };
+    let rough = frame.solved(x);
     assert!(!rough.within(bound), "Cholesky residual {:.3e} within {bound:.3e}", rough.residual);
     // The fit falls back to the LBLᵀ and interpolates every centre, the close pair included.
     let f = Rbf::fit(&c, &v, Kernel::Linear, "test").expect("fit");

@@ -6,10 +6,11 @@ use crate::mesh::Point3;
 
 use super::super::trimesh::IntMap;
 use super::dijkstra::{dijkstra_project, Projected};
-use super::snap::{closest_on_segment, keeps_orientation};
+use super::snap::keeps_orientation;
 use super::split::split_crossings;
 use super::stats::{detour, FailedSegment, Fallback};
 use super::{lock_chain, off_surface, route, Work};
+use crate::geometry::closest_on_segment;
 
 /// Largest number of faces the route fallback settles for one segment.
 const ROUTE_BUDGET: usize = 1_000_000;

@@ -1,16 +1,9 @@
 //! Moving a vertex onto a segment only where that turns no face of its star over.
 
-use crate::geometry::{add, cross, dot, norm, scale, sub};
+use crate::geometry::{cross, dot, norm, sub};
 use crate::mesh::Point3;
 
 use super::super::trimesh::TriMesh;
-
-pub(super) fn closest_on_segment(p: Point3, a: Point3, b: Point3) -> Point3 {
-    let ab = sub(b, a);
-    let l2 = dot(ab, ab);
-    let t = if l2 > 0.0 { (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    add(a, scale(ab, t))
-}
 
 /// Would moving `z` to `target` keep every face of its star turned the way `reference` says
 /// (the face's current normal when `reference` has none) and of non-negligible area?

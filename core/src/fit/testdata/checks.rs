@@ -1,8 +1,48 @@
 //! Checks of a fit's output against a known truth, shared by the tests and the sweeps so that each
-//! one is written once: faces turned against the truth's outward normal.
+//! one is written once: faces turned against the truth's outward normal, or against a truth
+//! surface given as a mesh.
 
 use crate::geometry::{dot, triangle_cross};
-use crate::mesh::{Mesh, Point3};
+use crate::mesh::{Faces, Mesh, Point3};
+use crate::spatial::Bvh;
+
+/// A truth given as a mesh (e.g. a template carried by a known deformation), for comparing a fit's
+/// output with it by closest points.
+pub struct TruthSurface {
+    positions: Vec<Point3>,
+    tris: Vec<[u32; 3]>,
+    bvh: Bvh,
+}
+
+impl TruthSurface {
+    pub fn new(truth: &Mesh) -> TruthSurface {
+        let tris = truth.faces.triangles();
+        let bvh = Bvh::new(&truth.positions, &Faces::from_triangles(&tris));
+        TruthSurface { positions: truth.positions.clone(), tris, bvh }
+    }
+
+    /// Faces of `out` whose normal opposes that of the truth face closest to their centroid
+    /// (meaningful where `out` lies within a part's thickness of the truth).
+    pub fn faces_against(&self, out: &Mesh) -> usize {
+        out.faces
+            .triangles()
+            .iter()
+            .filter(|t| {
+                let q = |k: usize| out.positions[t[k] as usize];
+                let c = [0, 1, 2].map(|k| (q(0)[k] + q(1)[k] + q(2)[k]) / 3.0);
+                self.bvh.closest(c).is_some_and(|h| {
+                    let g = |k: usize| self.positions[self.tris[h.face as usize][k] as usize];
+                    dot(triangle_cross(q(0), q(1), q(2)), triangle_cross(g(0), g(1), g(2))) < 0.0
+                })
+            })
+            .count()
+    }
+
+    /// The largest distance of an output vertex to the truth surface.
+    pub fn max_distance(&self, out: &Mesh) -> f64 {
+        out.positions.iter().map(|&q| self.bvh.closest(q).map_or(0.0, |h| h.dist2.sqrt())).fold(0.0, f64::max)
+    }
+}
 
 /// Indices of the (fan-triangulated) faces of `mesh` whose normal does not point along
 /// `outward(centroid)`: `n · outward ≤ 0`, so a zero-area face counts too (it faces nowhere).
