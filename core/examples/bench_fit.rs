@@ -12,7 +12,7 @@
 //! prints the fine stage's steps, its approach levels and the refinement.)
 //! The growth tables go past the headline: a 384k-vertex template (homer split 3), and 4,281 and
 //! 8,494 curve vertices (the same planes cut from homer split once and twice; the second is over
-//! the default `max_curve_vertices`, raised for it).
+//! the default `max_curve_vertices`, raised for it; `--dense-only` runs these two alone).
 
 use std::time::Instant;
 
@@ -510,6 +510,10 @@ fn main() {
     if std::env::args().any(|a| a == "--headline") {
         return;
     }
+    if std::env::args().any(|a| a == "--dense-only") {
+        dense_growth(&homer);
+        return;
+    }
 
     println!("== growth with template size (curves: every 2nd section point) ==");
     for split in [0, 1, 2, 3] {
@@ -525,21 +529,26 @@ fn main() {
         let (s, r) = time_fit(&c, 3);
         line(&format!("every {thin}, {} planes", if extra { 11 } else { 7 }), s, &r);
     }
-    // Beyond the headline's 2,156: the same 11 planes cut from homer split once and twice (the
-    // same surface, 2× and 4× the section points), fitted once each.
+    dense_growth(&homer);
+
+    println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
+    let c = case(&homer, 2, 1, true, false);
+    rbf_peer(&c);
+}
+
+/// Beyond the headline's 2,156 curve vertices (`--dense-only` runs these alone): the same 11 planes
+/// cut from homer split once and twice (the same surface, 2× and 4× the section points), fitted
+/// once each on the 96k template.
+fn dense_growth(homer: &Mesh) {
     for cut_split in [1, 2] {
-        let cut = subdivide_midpoint(&homer, cut_split);
-        let mut c = case_cut_from(&homer, &cut, 2, 1, true, true);
+        let cut = subdivide_midpoint(homer, cut_split);
+        let mut c = case_cut_from(homer, &cut, 2, 1, true, true);
         // 8,494 curve vertices at split 2: over the default `max_curve_vertices` (8,000), raised
         // here to measure the growth past it.
         c.params.max_curve_vertices = 20_000;
         let (s, r) = time_fit(&c, 1);
         line(&format!("sections of split {cut_split}, 11 planes"), s, &r);
     }
-
-    println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
-    let c = case(&homer, 2, 1, true, false);
-    rbf_peer(&c);
 }
 
 /// `--stage-cpu [RUNS]`: the headline with smoothing, run RUNS times, each with its wall time, its
