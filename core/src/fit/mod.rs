@@ -32,6 +32,7 @@ pub mod flips;
 pub mod groups;
 pub mod insert;
 pub mod kdtree;
+pub mod orientation;
 mod params;
 pub mod partition;
 pub mod rbf;
