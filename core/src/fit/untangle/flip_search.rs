@@ -12,11 +12,11 @@
 //! Here each folded face's neighbourhood (the faces at its corners, grown over the folded faces
 //! met there) is copied, and flip sequences of up to [`MAX_DEPTH`] non-locked edges are searched
 //! on the copy, each flip taken from the currently bad faces, intermediate states allowed to be
-//! worse (zero-area, folded). The best end state — fewest folded faces, then least fold energy
-//! — replaces the neighbourhood in the mesh when it has strictly fewer folded faces than
-//! before. Vertices never move and locked (curve) edges are never flipped, so every chain stays
-//! an edge chain and every curve vertex stays where it is; the edges only change among the
-//! neighbourhood's own vertices.
+//! worse (zero-area, folded). The best end state — fewest faces turned over (or zero-area), then
+//! fewest folded, then least fold energy — replaces the neighbourhood in the mesh when it is
+//! better on the first two counts than before. Vertices never move and locked (curve) edges are
+//! never flipped, so every chain stays an edge chain and every curve vertex stays where it is;
+//! the edges only change among the neighbourhood's own vertices.
 
 use std::collections::HashSet;
 
@@ -72,11 +72,13 @@ struct Patch {
 }
 
 impl Patch {
-    fn folded(&self) -> usize {
-        self.quality.iter().filter(|&&q| q <= MIN_COS).count()
-    }
-    fn energy(&self) -> f64 {
-        self.quality.iter().map(|&q| energy(q)).sum()
+    /// How bad the patch is, lexicographically: faces turned over or zero-area (what the report
+    /// counts as flipped or zero-area), then faces folded (within [`MIN_COS`] of perpendicular, or
+    /// beyond), then the summed fold energy.
+    fn badness(&self) -> (usize, usize, f64) {
+        let turned = self.quality.iter().filter(|&&q| q <= 0.0).count();
+        let folded = self.quality.iter().filter(|&&q| q <= MIN_COS).count();
+        (turned, folded, self.quality.iter().map(|&q| energy(q)).sum())
     }
     /// The local face with directed edge a → b.
     fn with_edge(&self, a: u32, b: u32) -> Option<usize> {
@@ -145,7 +147,8 @@ struct Search<'a> {
     mesh: &'a TriMesh,
     ctx: &'a Ctx<'a>,
     states: usize,
-    best: (usize, f64, Vec<[u32; 3]>, usize),
+    /// The best state seen: its badness, faces and depth (flips).
+    best: ((usize, usize, f64), Vec<[u32; 3]>, usize),
 }
 
 impl Search<'_> {
@@ -153,11 +156,12 @@ impl Search<'_> {
     /// undoing the flip just made (`last`: the edge it made).
     fn visit(&mut self, patch: &mut Patch, depth: usize, max_depth: usize, last: (u32, u32)) {
         self.states += 1;
-        let (folded, e) = (patch.folded(), patch.energy());
-        if (folded, e) < (self.best.0, self.best.1 - 1e-12) {
-            self.best = (folded, e, patch.faces.clone(), depth);
+        let (turned, folded, e) = patch.badness();
+        let (bt, bf, be) = self.best.0;
+        if (turned, folded) < (bt, bf) || ((turned, folded) == (bt, bf) && e < be - 1e-12) {
+            self.best = ((turned, folded, e), patch.faces.clone(), depth);
         }
-        if depth == max_depth || self.best.0 == 0 || self.states >= MAX_STATES {
+        if depth == max_depth || self.best.0 .1 == 0 || self.states >= MAX_STATES {
             return;
         }
         for (i, j, n1, n2) in candidate_flips(patch, self.mesh, self.ctx) {
@@ -166,7 +170,7 @@ impl Search<'_> {
             if (n1[1].min(n2[1]), n1[1].max(n2[1])) == last {
                 continue;
             }
-            if self.states >= MAX_STATES || self.best.0 == 0 {
+            if self.states >= MAX_STATES || self.best.0 .1 == 0 {
                 return;
             }
             let (old_i, old_j) = (patch.faces[i], patch.faces[j]);
@@ -191,17 +195,19 @@ fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> std::result::Result<usiz
     let faces: Vec<[u32; 3]> = original.iter().map(|&g| mesh.tris[g as usize]).collect();
     let quality_of: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
     let mut patch = Patch { original, faces, quality: quality_of };
-    let before = patch.folded();
-    let mut search = Search { mesh, ctx, states: 0, best: (before, patch.energy(), Vec::new(), 0) };
+    let before = patch.badness();
+    let mut search = Search { mesh, ctx, states: 0, best: (before, Vec::new(), 0) };
     // Shortest sequences first: a fix by one or two flips changes least.
     for max_depth in 1..=MAX_DEPTH {
         search.visit(&mut patch, 0, max_depth, (u32::MAX, u32::MAX));
-        if search.best.0 == 0 || search.states >= MAX_STATES {
+        if search.best.0 .1 == 0 || search.states >= MAX_STATES {
             break;
         }
     }
-    let (folded, _, new_faces, depth) = search.best;
-    if folded >= before || new_faces.is_empty() {
+    // Kept only with fewer faces turned over (or as many and fewer folded): a trade of two faces
+    // standing on their edge (folded, not flipped) for one turned over is refused.
+    let ((turned, folded, _), new_faces, depth) = search.best;
+    if (turned, folded) >= (before.0, before.1) || new_faces.is_empty() {
         return Err(patch.original);
     }
     for &g in &patch.original {
