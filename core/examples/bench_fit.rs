@@ -8,7 +8,11 @@
 //! (see docs/benchmarks.md → Fit: the shared one mixes worktrees' builds of this example):
 //! `CARGO_TARGET_DIR=/tmp/fit-rel cargo run --release -p meshwork-core --example bench_fit`
 //! (`--stage-cpu [RUNS]`: the headline with smoothing only, CPU and wall time per stage and a
-//! digest of the output, for comparing two builds under load.)
+//! digest of the output, for comparing two builds under load. `BENCH_FINE=1`: each table row also
+//! prints the fine stage's steps, its approach levels and the refinement.)
+//! The growth tables go past the headline: a 384k-vertex template (homer split 3), and 4,281 and
+//! 8,494 curve vertices (the same planes cut from homer split once and twice; the second is over
+//! the default `max_curve_vertices`, raised for it; `--dense-only` runs these two alone).
 
 use std::time::Instant;
 
@@ -334,7 +338,20 @@ fn diagnose(c: &Case, out: &Mesh, report: &serde_json::Value) {
 }
 
 fn case(homer: &Mesh, split: u32, thin: usize, extra_planes: bool, smooth: bool) -> Case {
-    let sections = thin_network(&plane_sections(homer, &planes(extra_planes)), thin);
+    case_cut_from(homer, homer, split, thin, extra_planes, smooth)
+}
+
+/// As [`case`], with the sections cut from `cut` (homer or a midpoint-split copy of it: the same
+/// surface, more section points per plane).
+fn case_cut_from(
+    homer: &Mesh,
+    cut: &Mesh,
+    split: u32,
+    thin: usize,
+    extra_planes: bool,
+    smooth: bool,
+) -> Case {
+    let sections = thin_network(&plane_sections(cut, &planes(extra_planes)), thin);
     let template = subdivide_midpoint(homer, split);
     let pairs = crossing_pairs(&sections, &template, 12, |p| bend(p, 1.0));
     let mut curves = sections;
@@ -372,6 +389,12 @@ fn time_fit(c: &Case, reps: usize) -> (f64, serde_json::Value) {
 
 fn line(label: &str, s: f64, r: &serde_json::Value) {
     let st = &r["stages"];
+    if std::env::var("BENCH_FINE").is_ok() {
+        eprintln!(
+            "  fine steps_ms {} approach_ms {} approach {} refine {}",
+            r["fine"]["steps_ms"], r["fine"]["approach_ms"], r["fine"]["approach"], r["refine"]
+        );
+    }
     println!(
         "{label:<34} {:>7} tmpl V {:>5} curve V {:>7.3} s | curves {:>6.1} coarse {:>6.1} fine {:>6.1} retri {:>6.1} part {:>5.1} smooth {:>6.1} ms | edges {:.4} flipped {} (truth: against {}, one rule only {}, off {}) folded edges {} (template {}) regions {} minangle {:.1}→{:.1}",
         r["template_vertices"],
@@ -487,11 +510,16 @@ fn main() {
     if std::env::args().any(|a| a == "--headline") {
         return;
     }
+    if std::env::args().any(|a| a == "--dense-only") {
+        dense_growth(&homer);
+        return;
+    }
 
     println!("== growth with template size (curves: every 2nd section point) ==");
-    for split in [0, 1, 2] {
+    for split in [0, 1, 2, 3] {
         let c = case(&homer, split, 2, true, true);
-        let (s, r) = time_fit(&c, 3);
+        // The 384k template once (several seconds a run).
+        let (s, r) = time_fit(&c, if split == 3 { 1 } else { 3 });
         line(&format!("homer split {split}"), s, &r);
     }
 
@@ -501,10 +529,26 @@ fn main() {
         let (s, r) = time_fit(&c, 3);
         line(&format!("every {thin}, {} planes", if extra { 11 } else { 7 }), s, &r);
     }
+    dense_growth(&homer);
 
     println!("== RBF stage vs SciPy RBFInterpolator (kernel linear, degree 1), same data ==");
     let c = case(&homer, 2, 1, true, false);
     rbf_peer(&c);
+}
+
+/// Beyond the headline's 2,156 curve vertices (`--dense-only` runs these alone): the same 11 planes
+/// cut from homer split once and twice (the same surface, 2× and 4× the section points), fitted
+/// once each on the 96k template.
+fn dense_growth(homer: &Mesh) {
+    for cut_split in [1, 2] {
+        let cut = subdivide_midpoint(homer, cut_split);
+        let mut c = case_cut_from(homer, &cut, 2, 1, true, true);
+        // 8,494 curve vertices at split 2: over the default `max_curve_vertices` (8,000), raised
+        // here to measure the growth past it.
+        c.params.max_curve_vertices = 20_000;
+        let (s, r) = time_fit(&c, 1);
+        line(&format!("sections of split {cut_split}, 11 planes"), s, &r);
+    }
 }
 
 /// `--stage-cpu [RUNS]`: the headline with smoothing, run RUNS times, each with its wall time, its
