@@ -85,8 +85,8 @@ fn main() {
                         let dev = surface.max_distance(m);
                         if std::env::var("SWEEP_DETAIL").is_ok() {
                             eprintln!(
-                                "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}",
-                                r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"]
+                                "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}\n  stages {}",
+                                r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"], r["stages"]
                             );
                         }
                         if std::env::var("SWEEP_FOLDS").is_ok() {

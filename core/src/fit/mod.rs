@@ -400,7 +400,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             )
         })?;
         out_pos = mesh.pos.clone();
-        if s.edge_flips > 0 {
+        if s.edge_flips + s.sequence_flips > 0 {
             // Flipped edges are never curve edges, so regions are unchanged; the labels are
             // recomputed for the new face list.
             out_tris = mesh.live_triangles();

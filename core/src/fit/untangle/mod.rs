@@ -23,6 +23,7 @@ use super::trimesh::TriMesh;
 use super::uvs::{self, UvMove};
 
 mod energy;
+mod flip_search;
 mod folds;
 mod kernel;
 mod patch;
@@ -44,6 +45,10 @@ pub struct UntangleStats {
     /// Folded regions untangled by moving all their free vertices at once ([`patch`]).
     pub patches_solved: usize,
     pub patch_vertex_moves: usize,
+    /// Neighbourhoods of folds among fixed vertices replaced by a flip sequence
+    /// ([`flip_search`]), and the flips in those sequences (not in `edge_flips`).
+    pub flip_sequences: usize,
+    pub sequence_flips: usize,
     pub folded_after: usize,
     /// Edges split to give a fold with fixed corners a free vertex ([`untangle_with_splits`]).
     pub edge_splits: usize,
@@ -152,6 +157,21 @@ pub fn untangle_polled(
         stats.uv_batches.extend(pass.uv_batches);
         left = local_passes(mesh, &ctx, &mut stats, max_passes, progress)?;
     }
+    // What moves cannot reach (folds among fixed vertices): flip sequences through worse
+    // intermediate states, then the local fixes again around the new faces.
+    for _ in 0..3 {
+        if left == 0 {
+            break;
+        }
+        let bad = folded_faces(mesh, &ctx, progress)?;
+        let pass = flip_search::flip_sequences(mesh, &ctx, &bad, progress)?;
+        if pass.regions == 0 {
+            break;
+        }
+        stats.flip_sequences += pass.regions;
+        stats.sequence_flips += pass.flips;
+        left = local_passes(mesh, &ctx, &mut stats, max_passes, progress)?;
+    }
     stats.folded_after = left;
     Ok(stats)
 }
@@ -248,6 +268,8 @@ pub fn untangle_with_splits(
         stats.vertex_moves += again.vertex_moves;
         stats.patches_solved += again.patches_solved;
         stats.patch_vertex_moves += again.patch_vertex_moves;
+        stats.flip_sequences += again.flip_sequences;
+        stats.sequence_flips += again.sequence_flips;
         stats.uv_batches.extend(again.uv_batches);
         stats.folded_after = again.folded_after;
         if stats.folded_after == 0 {
