@@ -12,7 +12,8 @@
 //! prints the fine stage's steps, its approach levels and the refinement.)
 //! The growth tables go past the headline: a 384k-vertex template (homer split 3), and 4,281 and
 //! 8,494 curve vertices (the same planes cut from homer split once and twice; the second is over
-//! the default `max_curve_vertices`, raised for it; `--dense-only` runs these two alone).
+//! the default `max_curve_vertices`, raised for it; `--dense-only` runs these two alone,
+//! `--dense-cpu` the second under `--stage-cpu`'s timing and digest).
 
 use std::time::Instant;
 
@@ -508,6 +509,14 @@ fn main() {
         }
     }
     if std::env::args().any(|a| a == "--headline") {
+        return;
+    }
+    if std::env::args().any(|a| a == "--dense-cpu") {
+        // The 8,494-vertex row under `--stage-cpu`'s timing and output digest.
+        let cut = subdivide_midpoint(&homer, 2);
+        let mut c = case_cut_from(&homer, &cut, 2, 1, true, true);
+        c.params.max_curve_vertices = 20_000;
+        stage_cpu(&c, 1);
         return;
     }
     if std::env::args().any(|a| a == "--dense-only") {

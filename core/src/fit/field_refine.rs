@@ -82,10 +82,15 @@ pub fn refine_for_field(
     if over == 0 {
         return Ok(stats);
     }
+    // Deviations already measured, by edge: a round splits only flagged faces and moves no vertex,
+    // so an edge that survives it keeps its deviation, and only the new edges are evaluated (the
+    // field at every edge's midpoint each round dominated dense networks: 8,494 curve vertices,
+    // 1,696 centres, ~300k edges, 11 rounds).
+    let mut measured: std::collections::HashMap<(u32, u32), f64> = std::collections::HashMap::new();
     for round in 0..=MAX_ROUNDS {
         progress.check()?;
         let (faces, worst) =
-            deviating_faces(pos, tris, disp, field, gate.tolerance, gate.min_edge, progress)?;
+            deviating_faces(pos, tris, disp, field, gate.tolerance, gate.min_edge, &mut measured, progress)?;
         stats.deviation_max = worst;
         if faces.is_empty() {
             break;
@@ -135,7 +140,9 @@ fn samples_over(
 }
 
 /// Faces with an edge (longer than `min_edge`) whose midpoint deviation exceeds `tolerance`, and
-/// the largest deviation seen.
+/// the largest deviation seen. `measured` holds the deviations of edges measured before (their
+/// ends and values unchanged); the others are evaluated and added.
+#[allow(clippy::too_many_arguments)]
 fn deviating_faces(
     pos: &[Point3],
     tris: &[[u32; 3]],
@@ -143,6 +150,7 @@ fn deviating_faces(
     field: &Rbf,
     tolerance: f64,
     min_edge: f64,
+    measured: &mut std::collections::HashMap<(u32, u32), f64>,
     progress: &Progress,
 ) -> Result<(Vec<u32>, f64)> {
     let mut seen: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
@@ -156,17 +164,21 @@ fn deviating_faces(
             }
         }
     }
+    let fresh: Vec<(u32, u32)> = edges.iter().copied().filter(|e| !measured.contains_key(e)).collect();
     let mids: Vec<Point3> =
-        edges.iter().map(|&(a, b)| scale(add(pos[a as usize], pos[b as usize]), 0.5)).collect();
+        fresh.iter().map(|&(a, b)| scale(add(pos[a as usize], pos[b as usize]), 0.5)).collect();
     let at_mid = field.eval_many(&mids, progress)?;
+    for (&(a, b), m) in fresh.iter().zip(&at_mid) {
+        let linear = scale(add(disp[a as usize], disp[b as usize]), 0.5);
+        measured.insert((a, b), norm(sub(*m, linear)));
+    }
     let mut bad: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
     let mut worst = 0.0f64;
-    for (&(a, b), m) in edges.iter().zip(&at_mid) {
-        let linear = scale(add(disp[a as usize], disp[b as usize]), 0.5);
-        let dev = norm(sub(*m, linear));
+    for e in &edges {
+        let dev = measured.get(e).copied().unwrap_or(0.0);
         worst = worst.max(dev);
         if dev > tolerance {
-            bad.insert((a, b));
+            bad.insert(*e);
         }
     }
     let flagged: Vec<u32> = tris
