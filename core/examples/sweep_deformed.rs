@@ -24,6 +24,9 @@ use meshwork_core::mesh::Point3;
 use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::Progress;
 
+/// A smooth map carrying the sections (and the truth) from the template.
+type Deform = fn(Point3) -> Point3;
+
 fn main() {
     let filter = std::env::args().nth(1).unwrap_or_default();
     let names = [
@@ -39,8 +42,7 @@ fn main() {
         "woody",
         "stanford-bunny",
     ];
-    let deforms: [(&str, fn(Point3) -> Point3); 3] =
-        [("ident", |p| p), ("bend", |p| bend(p, 1.0)), ("twist", twist)];
+    let deforms: [(&str, Deform); 3] = [("ident", |p| p), ("bend", |p| bend(p, 1.0)), ("twist", twist)];
     for name in names {
         let Ok(bytes) = std::fs::read(format!("../shared/meshes/{name}.obj")) else { continue };
         let raw = read(&bytes, &ReadOptions { name_hint: Some("x.obj".into()), ..Default::default() })

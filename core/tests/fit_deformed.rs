@@ -5,31 +5,14 @@
 //! the mapped template (distance to it, faces facing against it) and the regions the planes cut the
 //! unmapped surface into.
 
-use meshwork_core::fit::testdata::{
-    crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box, twist, TruthSurface,
-};
-use meshwork_core::io::{read, ReadOptions};
-use meshwork_core::job::{self, JobKind};
-use meshwork_core::mesh::{Mesh, Point3};
-use meshwork_core::repair::{self, RepairParams};
-use meshwork_core::Progress;
+mod fit_support;
 
-fn repaired_in_unit_box(name: &str) -> Mesh {
-    let dir = env!("CARGO_MANIFEST_DIR");
-    // The shared meshes beside the repository (CI) or beside the worktrees.
-    let bytes =
-        [format!("{dir}/../../shared/meshes/{name}.obj"), format!("{dir}/../../../shared/meshes/{name}.obj")]
-            .iter()
-            .find_map(|p| std::fs::read(p).ok())
-            .expect("mesh in ../shared/meshes");
-    let raw = read(&bytes, &ReadOptions { name_hint: Some(format!("{name}.obj")), ..Default::default() })
-        .expect("read")
-        .mesh;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut t = repair::run(raw, &params, &Progress::new()).expect("repair").meshes.remove(0);
-    to_unit_box(&mut t);
-    t
-}
+use meshwork_core::fit::testdata::{
+    crossing_pairs, plane_sections, section_regions, sweep_planes, twist, TruthSurface,
+};
+use meshwork_core::job::{self, JobKind};
+use meshwork_core::mesh::Point3;
+use meshwork_core::Progress;
 
 struct Fitted {
     report: serde_json::Value,
@@ -45,7 +28,7 @@ struct Fitted {
 /// Fits `name` to its own sweep sections carried by `map`, with 12 pairs at section crossings or
 /// the automatic alignment, as `sweep_deformed` does.
 fn fit_own_sections(name: &str, map: fn(Point3) -> Point3, with_pairs: bool) -> Fitted {
-    let template = repaired_in_unit_box(name);
+    let template = fit_support::load_repaired(name);
     let planes = sweep_planes(&template);
     let sections = plane_sections(&template, &planes);
     let regions = section_regions(&template, &planes);

@@ -155,15 +155,7 @@ fn automatic(
     for c in candidates {
         let warped = if c.contender {
             let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
-            let w = align::warp_icp(
-                &mut p,
-                tris,
-                &net.points,
-                super::approach::median_segment(net),
-                Some(&ends),
-                WARP_ITERATIONS,
-                progress,
-            )?;
+            let w = warp_to_curves(&mut p, tris, net, Some(&ends), progress)?;
             let gap = rim.end_gap(&p);
             let score = (w.rms_all_after.powi(2) + gap.unwrap_or(0.0).powi(2)).sqrt();
             Some((p, w, score, gap))
@@ -233,19 +225,24 @@ fn plain_scores(
     let mut scores = Vec::new();
     for c in candidates.iter().filter(|c| c.contender) {
         let mut p: Vec<Point3> = pos.iter().map(|&x| c.sim.apply(x)).collect();
-        let w = align::warp_icp(
-            &mut p,
-            tris,
-            &net.points,
-            super::approach::median_segment(net),
-            None,
-            WARP_ITERATIONS,
-            progress,
-        )?;
+        let w = warp_to_curves(&mut p, tris, net, None, progress)?;
         scores.push((w.rms_all_after.powi(2) + rim.end_gap(&p).unwrap_or(0.0).powi(2)).sqrt());
     }
     scores.sort_by(f64::total_cmp);
     Ok(scores)
+}
+
+/// The smooth warp of a placed template towards the curve points ([`align::warp_icp`]), with the
+/// curves' median segment as the trim floor's spacing and the rim matches of `ends`, if any.
+fn warp_to_curves(
+    pos: &mut [Point3],
+    tris: &[[u32; 3]],
+    net: &curves::CurveNetwork,
+    ends: Option<&align::RimEnds>,
+    progress: &Progress,
+) -> Result<align::WarpReport> {
+    let spacing = super::approach::median_segment(net);
+    align::warp_icp(pos, tris, &net.points, spacing, ends, WARP_ITERATIONS, progress)
 }
 
 /// Curves whose smallest spread is under this share of the largest lie in one plane: the warp then
@@ -345,15 +342,7 @@ fn pairs_similarity(
     for p in pos.iter_mut() {
         *p = sim.apply(*p);
     }
-    let warp = align::warp_icp(
-        pos,
-        tris,
-        &net.points,
-        super::approach::median_segment(net),
-        None,
-        WARP_ITERATIONS,
-        progress,
-    )?;
+    let warp = warp_to_curves(pos, tris, net, None, progress)?;
     Ok(CoarseReport {
         method: "pairs_similarity",
         pair_curve_points: fixed.iter().map(|x| x.0).collect(),

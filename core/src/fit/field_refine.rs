@@ -27,6 +27,7 @@ use crate::mesh::Point3;
 
 use super::insert::{barycentric, Foot};
 use super::rbf::Rbf;
+use super::trimesh::IntMap;
 
 /// Rounds of splitting per field (each halves the edges it touches).
 const MAX_ROUNDS: usize = 4;
@@ -86,7 +87,7 @@ pub fn refine_for_field(
     // so an edge that survives it keeps its deviation, and only the new edges are evaluated (the
     // field at every edge's midpoint each round dominated dense networks: 8,494 curve vertices,
     // 1,696 centres, ~300k edges, 11 rounds).
-    let mut measured: std::collections::HashMap<(u32, u32), f64> = std::collections::HashMap::new();
+    let mut measured: IntMap<(u32, u32), f64> = IntMap::default();
     for round in 0..=MAX_ROUNDS {
         progress.check()?;
         let (faces, worst) =
@@ -150,7 +151,7 @@ fn deviating_faces(
     field: &Rbf,
     tolerance: f64,
     min_edge: f64,
-    measured: &mut std::collections::HashMap<(u32, u32), f64>,
+    measured: &mut IntMap<(u32, u32), f64>,
     progress: &Progress,
 ) -> Result<(Vec<u32>, f64)> {
     let mut seen: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
