@@ -121,17 +121,21 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
     let mut coarse =
         stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
-    // Crossings the network joined are checked against the aligned template: curves on two
-    // sheets of a self-intersecting template are not joined (the network is built again).
+    // Crossings and T-junctions the network joined are checked against the aligned template:
+    // curves on two pieces, or on two sheets of a self-intersecting template, are not joined (the
+    // network is built again).
     let net = stages.run(progress, "curves_on_sheets", || {
-        let joined = net.stats.crossings_inserted + net.stats.crossings_at_vertices;
+        let joined = net.stats.crossings_inserted
+            + net.stats.crossings_at_vertices
+            + net.stats.t_junctions
+            + net.stats.ends_merged;
         if joined == 0 {
             return Ok(net);
         }
         let sheets = sheets::Sheets::new(&pos, &tris);
         let checked =
             curves::CurveNetwork::build_checked(&curve_mesh, &options, &|a, b| sheets.may_join(a, b))?;
-        if checked.stats.crossings_on_two_sheets == 0 {
+        if checked.stats.crossings_on_two_sheets + checked.stats.ends_on_two_sheets == 0 {
             return Ok(net);
         }
         coarse.pair_curve_points = sheets::renumber_points(&net, &checked, &coarse.pair_curve_points);

@@ -19,11 +19,12 @@
 //! it, one across) or a template that is not yet at the curves (feet far from the segment ends)
 //! keeps the join.
 
-use crate::geometry::{add, dist, dot, normalize, sub, triangle_cross};
+use crate::geometry::{add, dist, dot, normalize, scale, sub, triangle_cross};
 use crate::mesh::{Faces, Point3};
 use crate::spatial::Bvh;
 
 use super::curves::CurveNetwork;
+use super::insert::walk::face_components;
 
 /// A foot farther than this × the shorter segment: the template is not at the curves there.
 const NEAR: f64 = 0.25;
@@ -39,6 +40,8 @@ const OPPOSED: f64 = -0.5;
 pub struct Sheets {
     bvh: Bvh,
     normals: Vec<Point3>,
+    /// Connected piece of each face (faces sharing a vertex are connected).
+    piece: Vec<u32>,
 }
 
 impl Sheets {
@@ -47,13 +50,24 @@ impl Sheets {
             .iter()
             .map(|t| normalize(triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])))
             .collect();
-        Sheets { bvh: Bvh::new(pos, &Faces::from_triangles(tris)), normals }
+        let piece = face_components(pos.len(), tris);
+        Sheets { bvh: Bvh::new(pos, &Faces::from_triangles(tris)), normals, piece }
     }
 
-    /// Whether segments `a` and `b`, which cross in space, may be joined: false only when the
-    /// template has them on two sheets that pass through each other (see the module doc).
+    /// Whether segments `a` and `b`, which cross in space (or one ends at the other), may be
+    /// joined: false only when the template has them on two pieces, or on two sheets that pass
+    /// through each other (see the module doc).
     pub fn may_join(&self, a: [Point3; 2], b: [Point3; 2]) -> bool {
-        let near = NEAR * dist(a[0], a[1]).min(dist(b[0], b[1]));
+        let (la, lb) = (dist(a[0], a[1]), dist(b[0], b[1]));
+        // (The longer segment sets the reach here: a segment cut short by a crossing is no
+        // reason to think the template is not at the curves.)
+        let reach = NEAR * la.max(lb);
+        if let (Some(pa), Some(pb)) = (self.segment_piece(a, reach), self.segment_piece(b, reach)) {
+            if pa != pb {
+                return false;
+            }
+        }
+        let near = NEAR * la.min(lb);
         let (Some(na), Some(nb)) = (self.sheet_normal(a, near), self.sheet_normal(b, near)) else {
             return true;
         };
@@ -62,6 +76,18 @@ impl Sheets {
         let piercing = dot(ta, nb).abs() > PIERCING && dot(tb, na).abs() > PIERCING;
         let two_sheets = facing < OPPOSED || (facing < 0.0 && piercing);
         !two_sheets
+    }
+
+    /// The piece under at least two of segment `s`'s ends and midpoint (feet within `near`), or
+    /// None (a segment across the place where two pieces touch, or far from the template).
+    fn segment_piece(&self, s: [Point3; 2], near: f64) -> Option<u32> {
+        let mid = scale(add(s[0], s[1]), 0.5);
+        let under: Vec<u32> = [s[0], mid, s[1]]
+            .into_iter()
+            .filter_map(|p| self.bvh.closest(p).filter(|c| c.dist2 <= near * near))
+            .map(|c| self.piece[c.face as usize])
+            .collect();
+        under.iter().copied().find(|&p| under.iter().filter(|&&q| q == p).count() >= 2)
     }
 
     /// The template's normal under segment `s`: the sum of its ends' foot faces' normals, or None
@@ -99,7 +125,6 @@ pub fn renumber_points(before: &CurveNetwork, after: &CurveNetwork, ids: &[u32])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::scale;
 
     /// Two unit squares: one in z = 0, one in the plane x = 0.5 (normal +x), crossing it along
     /// the line x = 0.5, z = 0: two sheets passing through each other. The second square spans
@@ -154,6 +179,31 @@ mod tests {
         // The same crossing with the template far from the curves (all moved up by 1) is joined.
         let lifted: Vec<Point3> = pos.iter().map(|p| [p[0], p[1], p[2] + 1.0]).collect();
         assert!(Sheets::new(&lifted, &tris).may_join(a, b));
+    }
+
+    #[test]
+    fn curves_on_two_pieces_that_touch_in_one_plane_may_not_join() {
+        // Two unit squares side by side in z = 0, touching along x = 1 but sharing no vertex:
+        // two pieces, normals equal (the normal test alone would join them). An end on the
+        // right square next to a segment on the left one, and a crossing over the seam.
+        let pos = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let tris = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+        let s = Sheets::new(&pos, &tris);
+        let left = [[0.9, 0.3, 0.0], [0.9, 0.7, 0.0]];
+        let right_end = [[1.3, 0.5, 0.0], [0.91, 0.5, 0.0]];
+        assert!(!s.may_join(right_end, left), "the end's segment lies on the right square");
+        assert!(!s.may_join(left, right_end), "symmetric");
+        // Both on the left square: joined.
+        assert!(s.may_join([[0.5, 0.5, 0.0], [0.89, 0.5, 0.0]], left));
     }
 
     #[test]

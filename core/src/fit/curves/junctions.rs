@@ -299,8 +299,10 @@ impl Builder {
         best.retain(|p, _| keep.contains_key(p));
     }
 
-    /// Step 3b: curve ends near another polyline's segment join it (T-junctions).
-    pub(super) fn join_ends(&mut self, tol: f64) {
+    /// Step 3b: curve ends near another polyline's segment join it (T-junctions), where
+    /// `may_join(end segment, segment)` (the fit asks its aligned template: an end on another
+    /// piece or sheet is left free, counted in `ends_on_two_sheets`).
+    pub(super) fn join_ends(&mut self, tol: f64, may_join: &MayJoin<'_>) {
         let segs = self.segments();
         let degree = self.degrees(&segs);
         let ends: Vec<u32> = (0..self.points.len() as u32).filter(|&p| degree[p as usize] == 1).collect();
@@ -321,6 +323,7 @@ impl Builder {
         let ns = segs.len();
         // Best segment per end: (gap / tolerance, segment, parameter).
         let mut best: HashMap<u32, (f64, usize, f64)> = HashMap::new();
+        let mut refused: Vec<u32> = Vec::new();
         for (i, j) in overlapping(&boxes) {
             let (si, ei) = if i < ns && j >= ns {
                 (i, j - ns)
@@ -341,9 +344,16 @@ impl Builder {
             let gap = dist(p, lerp(a, b, t));
             let allowed = tol * self.len(s);
             if gap <= allowed && best.get(&e).map_or(true, |x| gap / allowed < x.0) {
+                if !may_join([p, self.points[n as usize]], [a, b]) {
+                    refused.push(e);
+                    continue;
+                }
                 best.insert(e, (gap / allowed, si, t));
             }
         }
+        refused.sort_unstable();
+        refused.dedup();
+        self.stats.ends_on_two_sheets += refused.iter().filter(|e| !best.contains_key(e)).count();
         let mut ends_sorted: Vec<u32> = best.keys().copied().collect();
         ends_sorted.sort();
         let mut splits: HashMap<(u32, u32), Vec<(f64, u32)>> = HashMap::new();

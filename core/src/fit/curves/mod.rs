@@ -107,6 +107,9 @@ pub struct NetworkStats {
     /// Crossings left unjoined because the aligned template has the two curves on two sheets
     /// that pass through each other (a self-intersecting template; see `fit::sheets`).
     pub crossings_on_two_sheets: usize,
+    /// Curve ends left free (no T-junction, no merge) for the same reason, or because the end
+    /// and the segment it would join lie on two pieces of the template (see `fit::sheets`).
+    pub ends_on_two_sheets: usize,
     /// Largest gap closed by a junction or crossing (model units).
     pub junction_max_gap: f64,
     /// Curve ends left free (degree 1) after the junctions.
@@ -128,9 +131,10 @@ impl CurveNetwork {
         Self::build_checked(curves, opt, &|_, _| true)
     }
 
-    /// [`CurveNetwork::build`] joining two crossing segments `a`, `b` only where `may_join(a, b)`
-    /// (the fit asks its aligned template: [`crate::fit::sheets`]); refusals are counted in
-    /// `crossings_on_two_sheets`.
+    /// [`CurveNetwork::build`] joining two crossing segments `a`, `b` (or an end's segment `a` to
+    /// a segment `b`) only where `may_join(a, b)` (the fit asks its aligned template:
+    /// [`crate::fit::sheets`]); refusals are counted in `crossings_on_two_sheets` and
+    /// `ends_on_two_sheets`.
     pub fn build_checked(curves: &Mesh, opt: &NetworkOptions, may_join: &MayJoin<'_>) -> Result<Self> {
         if curves.curves.is_empty() {
             return Err(Error::params(
@@ -203,7 +207,7 @@ impl CurveNetwork {
         b.merge_near_duplicates(opt.merge_tolerance);
         if opt.junction_tolerance > 0.0 {
             b.merge_overlaps();
-            b.join_ends(opt.junction_tolerance);
+            b.join_ends(opt.junction_tolerance, may_join);
             b.insert_crossings(opt.junction_tolerance, may_join);
         }
         Ok(b.finish(&polyline_input))
