@@ -158,6 +158,20 @@ fn main() {
                     );
                     eprintln!("  stages {}; fine {}", r["stages"], r["fine"]);
                     eprintln!("  zero-area faces {}", r["zero_area_faces"]);
+                    // Truths where they apply: the template itself (cases "vs own sections" with
+                    // alignment none), the direction from the curves' centroid (star-shaped truths:
+                    // spheres, ellipsoids about their centre).
+                    let m = &o.meshes[0];
+                    let n = curves.positions.len().max(1) as f64;
+                    let centre = [0, 1, 2].map(|k| curves.positions.iter().map(|p| p[k]).sum::<f64>() / n);
+                    let radial = meshwork_core::fit::testdata::faces_against(m, |c| {
+                        [c[0] - centre[0], c[1] - centre[1], c[2] - centre[2]]
+                    });
+                    eprintln!(
+                        "  faces against the template surface {}; against the radial direction {}",
+                        meshwork_core::fit::testdata::TruthSurface::new(&template).faces_against(m),
+                        radial.len()
+                    );
                 }
                 let off = r["retriangulation"]["off_surface_segments"].as_u64().unwrap_or(0);
                 let status = match (bad.is_empty(), r["retriangulation"]["failed_pieces"].as_u64()) {
@@ -167,12 +181,14 @@ fn main() {
                     _ => format!("BAD {}", bad.join("; ")),
                 };
                 format!(
-                    "{status} | regions {} faces {}→{} edges {} flips {} resid {:.1e} angle {:.1}/{:.1} net {}",
+                    "{status} | regions {} faces {}→{} edges {} flips {} (fine surface {}, inverted {}) resid {:.1e} angle {:.1}/{:.1} net {}",
                     r["regions"],
                     r["template_triangles"],
                     r["output_faces"],
                     r["segments_as_edges"],
                     r["flipped_faces"],
+                    r["flipped_faces_against_fine_surface"],
+                    r["faces_inverted_by_maps"],
                     r["curve_residual_max_relative"].as_f64().unwrap_or(f64::NAN),
                     r["min_angle_deg_before_smoothing"].as_f64().unwrap_or(f64::NAN),
                     r["min_angle_deg_after_smoothing"].as_f64().unwrap_or(f64::NAN),

@@ -12,7 +12,7 @@ use crate::mesh::Point3;
 use super::kdtree::KdTree;
 
 mod warp;
-pub use warp::{warp_icp, RimEnds, WarpReport};
+pub use warp::{warp_icp, RimEnds, WarpMap, WarpReport};
 
 /// Eigen-decomposition of a small symmetric matrix (row-major `n×n`), as
 /// [`crate::register::symmetric_eigen`] computes it, with the eigenvectors laid out as columns
@@ -41,6 +41,11 @@ impl Similarity {
         let r = &self.r;
         let q = [dot(r[0], p), dot(r[1], p), dot(r[2], p)];
         add(scale(q, self.s), self.t)
+    }
+
+    /// The Jacobian s·R.
+    pub fn jacobian(&self) -> [[f64; 3]; 3] {
+        self.r.map(|row| row.map(|x| x * self.s))
     }
 
     pub fn inverse_apply(&self, p: Point3) -> Point3 {

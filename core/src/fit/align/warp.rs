@@ -23,6 +23,61 @@ pub struct WarpReport {
     pub rms_all_after: f64,
     /// Iterations whose step was halved because the full step folded faces.
     pub damped: u32,
+    /// The warp itself, for its Jacobian (not serialised).
+    #[serde(skip)]
+    pub map: WarpMap,
+}
+
+/// The kept steps of a warp: per degree stage, each step x ↦ x + Σ cₖ mₖ((x − centre)/radius)
+/// applied to the result of the ones before ([`LazyWarp`]).
+#[derive(Debug, Clone, Default)]
+pub struct WarpMap {
+    centre: Point3,
+    radius: f64,
+    steps: Vec<Vec<[f64; 3]>>,
+}
+
+impl WarpMap {
+    /// The Jacobian of the whole warp at `p` (the steps' Jacobians multiplied along the way).
+    pub fn jacobian(&self, p: Point3) -> [[f64; 3]; 3] {
+        let mut j = super::super::orientation::IDENTITY;
+        let mut x = p;
+        for coef in &self.steps {
+            let u = scale(sub(x, self.centre), 1.0 / self.radius);
+            let degree = if coef.len() > 4 { 2 } else { 1 };
+            let grads = monomial_gradients(u);
+            let mut step = super::super::orientation::IDENTITY;
+            for (c, g) in coef.iter().zip(grads) {
+                for r in 0..3 {
+                    for k in 0..3 {
+                        step[r][k] += c[r] * g[k] / self.radius;
+                    }
+                }
+            }
+            j = super::super::orientation::mat_mul(&step, &j);
+            let (m, _) = monomials(u, degree);
+            for (c, mj) in coef.iter().zip(m) {
+                x = add(x, scale(*c, mj));
+            }
+        }
+        j
+    }
+}
+
+/// Gradients (in u) of the monomials of [`monomials`], in the same order.
+fn monomial_gradients(u: Point3) -> [Point3; 10] {
+    [
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [2.0 * u[0], 0.0, 0.0],
+        [0.0, 2.0 * u[1], 0.0],
+        [0.0, 0.0, 2.0 * u[2]],
+        [u[1], u[0], 0.0],
+        [0.0, u[2], u[1]],
+        [u[2], 0.0, u[0]],
+    ]
 }
 
 /// The template's rim (its boundary edges) and the curve ends (network degree 1) within `cap` of
@@ -178,6 +233,7 @@ pub fn warp_icp(
     if !(radius > 0.0) {
         return Ok(report);
     }
+    report.map = WarpMap { centre, radius, steps: Vec::new() };
     let mut tracked = TrackedFeet::new(pos, tris, points, &which, progress)?;
     // Faces touching the template's open boundary: a foot there may be a curve running off the
     // template, which the trim is for, so the floor does not keep it.
@@ -278,6 +334,7 @@ pub fn warp_icp(
             warp.steps.truncate(ok);
         }
         report.iterations[stage] = warp.steps.len() as u32;
+        report.map.steps.extend(warp.steps.iter().cloned());
         pos.copy_from_slice(&moved);
         tracked.rebase(pos);
     }
@@ -486,5 +543,46 @@ impl TrackedFeet {
             })?);
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The warp's Jacobian (its steps' Jacobians multiplied) against central differences of the
+    /// warp applied step by step, for an affine step followed by a quadratic one.
+    #[test]
+    fn the_warp_jacobian_matches_finite_differences() {
+        let affine = vec![[0.1, -0.2, 0.05], [0.3, 0.1, 0.0], [-0.1, 0.2, 0.1], [0.0, 0.05, -0.3]];
+        let quadratic: Vec<[f64; 3]> = (0..10)
+            .map(|i| [0.05 * (i as f64).sin(), 0.04 * (i as f64 * 0.7).cos(), -0.03 * i as f64 * 0.1])
+            .collect();
+        let map = WarpMap { centre: [0.2, -0.1, 0.3], radius: 1.7, steps: vec![affine, quadratic] };
+        let apply = |p: Point3| {
+            let mut x = p;
+            for coef in &map.steps {
+                let u = scale(sub(x, map.centre), 1.0 / map.radius);
+                let (m, _) = monomials(u, if coef.len() > 4 { 2 } else { 1 });
+                for (c, mj) in coef.iter().zip(m) {
+                    x = add(x, scale(*c, mj));
+                }
+            }
+            x
+        };
+        for p in [[0.0, 0.0, 0.0], [1.0, -0.5, 0.25], [-2.0, 1.5, 0.7]] {
+            let j = map.jacobian(p);
+            let h = 1e-6;
+            for col in 0..3 {
+                let (mut a, mut b) = (p, p);
+                a[col] += h;
+                b[col] -= h;
+                let (ea, eb) = (apply(a), apply(b));
+                for row in 0..3 {
+                    let fd = (ea[row] - eb[row]) / (2.0 * h);
+                    assert!((j[row][col] - fd).abs() < 1e-7 * (1.0 + fd.abs()), "{j:?} at {p:?}");
+                }
+            }
+        }
     }
 }

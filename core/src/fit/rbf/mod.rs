@@ -399,6 +399,48 @@ impl Rbf {
         (s(acc[0]), s(acc[1]), s(acc[2]))
     }
 
+    /// The field's Jacobian at `p`: `g[r][c]` = ∂(displacement r)/∂(p c). The map `x ↦ x + s(x)`
+    /// has Jacobian I + g ([`super::orientation`]). φ = r has no gradient at a centre (a cone's
+    /// apex): there that centre's term is left out.
+    pub fn gradient(&self, p: Point3) -> [[f64; 3]; 3] {
+        let q = [
+            (p[0] - self.origin[0]) / self.scale,
+            (p[1] - self.origin[1]) / self.scale,
+            (p[2] - self.origin[2]) / self.scale,
+        ];
+        let mut g = match self.kernel {
+            // φ'(r)/r: 1/r for φ = r, 3r for φ = r³.
+            Kernel::Linear => self.gradient_sum(q, |r2| 1.0 / r2.max(1e-300).sqrt()),
+            Kernel::Cubic => self.gradient_sum(q, |r2| 3.0 * r2.sqrt()),
+        };
+        for (r, row) in g.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = (*x + self.affine[c][r]) / self.scale;
+            }
+        }
+        g
+    }
+
+    /// Σ_j α_j ⊗ (q − c_j) φ'(r_j)/r_j in the normalised frame, `dphi_over_r` given r².
+    #[inline(always)]
+    fn gradient_sum(&self, q: Point3, dphi_over_r: impl Fn(f64) -> f64) -> [[f64; 3]; 3] {
+        let n = self.cx.len();
+        let (cx, cy, cz) = (&self.cx[..n], &self.cy[..n], &self.cz[..n]);
+        let (wx, wy, wz) = (&self.w[0][..n], &self.w[1][..n], &self.w[2][..n]);
+        let mut g = [[0.0f64; 3]; 3];
+        for j in 0..n {
+            let d = [q[0] - cx[j], q[1] - cy[j], q[2] - cz[j]];
+            let f = dphi_over_r(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            let a = [wx[j] * f, wy[j] * f, wz[j] * f];
+            for r in 0..3 {
+                for c in 0..3 {
+                    g[r][c] += a[r] * d[c];
+                }
+            }
+        }
+        g
+    }
+
     /// The field at many points (rayon over chunks; polls `progress` between chunks).
     pub fn eval_many(&self, points: &[Point3], progress: &Progress) -> Result<Vec<Point3>> {
         let mut out = vec![[0.0; 3]; points.len()];

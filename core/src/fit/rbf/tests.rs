@@ -183,3 +183,32 @@ fn a_system_the_cholesky_solves_too_roughly_is_solved_by_the_lblt() {
 }
 
 const GAP: f64 = 5e-9;
+
+/// The analytic gradient against central differences of the field, for both kernels, at points
+/// away from the centres.
+#[test]
+fn the_gradient_matches_finite_differences() {
+    let c: Vec<Point3> = (0..23)
+        .map(|i| [(i as f64 * 0.37).sin(), (i as f64 * 0.91).cos(), (i * i % 7) as f64 * 0.1])
+        .collect();
+    let vals: Vec<Point3> = (0..23)
+        .map(|i| [(i as f64 * 1.3).cos() * 0.2, (i as f64 * 0.4).sin() * 0.1, i as f64 * 0.01])
+        .collect();
+    for kernel in [Kernel::Linear, Kernel::Cubic] {
+        let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
+        for p in [[0.11, 0.23, 0.37], [-0.6, 0.4, 0.05], [1.5, -1.0, 2.0]] {
+            let g = f.gradient(p);
+            let h = 1e-6;
+            for col in 0..3 {
+                let (mut a, mut b) = (p, p);
+                a[col] += h;
+                b[col] -= h;
+                let (ea, eb) = (f.eval(a), f.eval(b));
+                for row in 0..3 {
+                    let fd = (ea[row] - eb[row]) / (2.0 * h);
+                    assert!((g[row][col] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "{kernel:?} {g:?} at {p:?}");
+                }
+            }
+        }
+    }
+}
