@@ -1,7 +1,7 @@
 //! Sweep (by hand, not in CI) of the fit on a realistic use: each shared mesh, repaired and in the
 //! unit box, fitted to its own plane sections (the sweep's planes) carried by a smooth non-rigid
-//! deformation: none ("ident"), `testdata::bend`, or a twist of 0.7 rad per unit length with an
-//! anisotropic scale ("twist"); the deformation keeps the topology, so the truth is the
+//! deformation: none ("ident"), `testdata::bend`, or `testdata::twist` (0.7 rad per unit length with an
+//! anisotropic scale, "twist"); the deformation keeps the topology, so the truth is the
 //! deformed template and its section regions are the template's. Alignment automatic, or 12
 //! user pairs at section crossings (`testdata::crossing_pairs`, as `bench_fit`). Prints the
 //! report's flips, edges and regions and, counted here against the truth: `against`, output faces
@@ -15,7 +15,7 @@
 use std::time::Instant;
 
 use meshwork_core::fit::testdata::{
-    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box, TruthSurface,
+    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, to_unit_box, twist, TruthSurface,
 };
 use meshwork_core::geometry::{dot, triangle_cross};
 use meshwork_core::io::{read, ReadOptions};
@@ -23,13 +23,6 @@ use meshwork_core::job::{self, JobKind};
 use meshwork_core::mesh::Point3;
 use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::Progress;
-
-fn twist(p: Point3) -> Point3 {
-    let (x, y, z) = (p[0] - 0.5, p[1] - 0.5, p[2] - 0.5);
-    let a = 0.7 * x;
-    let (c, s) = (a.cos(), a.sin());
-    [0.5 + 1.2 * x, 0.5 + 0.85 * (c * y - s * z), 0.5 + 0.85 * (s * y + c * z)]
-}
 
 fn main() {
     let filter = std::env::args().nth(1).unwrap_or_default();

@@ -133,6 +133,17 @@ pub fn bend(p: Point3, size: f64) -> Point3 {
     ]
 }
 
+/// A smooth, orientation-preserving twist for targets with a known truth (the unit box's centre
+/// fixed): 0.7 rad per unit length about the x axis, with the scale 1.2 × 0.85 × 0.85. Unlike
+/// [`bend`] it turns the ends of a unit-box shape 0.35 rad each way, so closest points of an
+/// aligned template fall beside their true place.
+pub fn twist(p: Point3) -> Point3 {
+    let (x, y, z) = (p[0] - 0.5, p[1] - 0.5, p[2] - 0.5);
+    let a = 0.7 * x;
+    let (c, s) = (a.cos(), a.sin());
+    [0.5 + 1.2 * x, 0.5 + 0.85 * (c * y - s * z), 0.5 + 0.85 * (s * y + c * z)]
+}
+
 /// Keeps every `k`-th vertex along the runs between network nodes (vertices whose degree is not
 /// 2, kept always), returning polylines node to node. Used to make a section network coarser than
 /// the template it is fitted with.
