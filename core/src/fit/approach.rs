@@ -92,6 +92,7 @@ pub fn approach(
     levels: usize,
     max_distance: f64,
     rim_feet: bool,
+    orientation: &mut super::orientation::Orientation,
     progress: &Progress,
 ) -> Result<ApproachReport> {
     let mut report = ApproachReport::default();
@@ -203,6 +204,11 @@ pub fn approach(
             report.step.push(0.0);
             continue;
         }
+        // The template's normals through this level's map, x ↦ x + step · s(x).
+        orientation.sync(parents);
+        orientation.push(pos, |_, p| {
+            super::coarse::plus_identity(field.gradient(p).map(|row| row.map(|x| x * step)))
+        });
         pos.copy_from_slice(&moved);
         for &(p, v) in fixed {
             pos[v as usize] = net.points[p as usize];

@@ -255,6 +255,28 @@ impl Orientation {
 
     /// Faces whose normal opposes their reference ([`Orientation::reference`]).
     pub fn faces_against(&self, pos: &[Point3], tris: &[[u32; 3]]) -> usize {
+        if std::env::var("FIT_DIAG_FLIPS").is_ok() {
+            for t in tris {
+                let n = triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+                let r = self.reference(t);
+                if dot(n, r) < 0.0 {
+                    let places = t.map(|v| self.places[v as usize]);
+                    let shared = self.common_faces(places.iter().copied());
+                    let per: Vec<(f64, f64)> = t
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &v)| {
+                            let nn = match shared.as_ref().and_then(|c| c.first().copied()) {
+                                Some(f) => self.face_normals[f as usize],
+                                None => self.template_normal(places[k]),
+                            };
+                            (det(&self.jacobians[v as usize]), dot(normalize(n), push_normal(&self.jacobians[v as usize], nn)))
+                        })
+                        .collect();
+                    eprintln!("DIAGFLIP {t:?} places {places:?} shared {shared:?} area {:.2e} det/dot {per:?}", crate::geometry::norm(n) / 2.0);
+                }
+            }
+        }
         tris.par_iter()
             .filter(|t| {
                 let n = triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
