@@ -182,6 +182,8 @@ pub fn approach(
             continue;
         }
         let Ok(field) = Rbf::fit(&centres, &values, kernel, "fine") else { continue };
+        // Shared with the orientation count, which may evaluate its Jacobian again exactly.
+        let field = std::sync::Arc::new(field);
         let mut disp = field.eval_many(pos, progress)?;
         let targets: Vec<Point3> = sample.iter().map(|&p| net.points[p as usize]).collect();
         let refined = super::field_refine::refine_for_field(
@@ -206,9 +208,7 @@ pub fn approach(
         }
         // The template's normals through this level's map, x ↦ x + step · s(x).
         orientation.sync(parents);
-        orientation.push(pos, |_, p| {
-            super::coarse::plus_identity(field.gradient(p).map(|row| row.map(|x| x * step)))
-        });
+        orientation.push_field(pos, field.clone(), step, progress)?;
         pos.copy_from_slice(&moved);
         for &(p, v) in fixed {
             pos[v as usize] = net.points[p as usize];

@@ -8,7 +8,7 @@ use crate::geometry::{add, dist, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
-use super::coarse::{fit_rbf, plus_identity, CoarseReport};
+use super::coarse::{fit_rbf, CoarseReport};
 use super::insert::coincident;
 use super::orientation::Orientation;
 use super::rbf::Rbf;
@@ -129,7 +129,7 @@ pub(super) fn fine_dispatch(
     };
     // The template's normals through the fine RBF, at every vertex the stage kept.
     orientation.sync(parents);
-    orientation.push(pos, |_, p| plus_identity(field.gradient(p)));
+    orientation.push_field(pos, std::sync::Arc::new(field), 1.0, progress)?;
     Ok(fine)
 }
 

@@ -26,7 +26,10 @@ use super::align::sym_eigen;
 use super::kdtree::KdTree;
 
 mod cpd_solve;
+mod gradient;
 mod system;
+
+pub use gradient::BoundedGradient;
 
 pub use system::{CHOLESKY_CENTRES, CHOLESKY_MIN_SPREAD};
 
@@ -408,14 +411,7 @@ impl Rbf {
             (p[1] - self.origin[1]) / self.scale,
             (p[2] - self.origin[2]) / self.scale,
         ];
-        #[cfg(target_arch = "x86_64")]
-        let fast = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
-        #[cfg(not(target_arch = "x86_64"))]
-        let fast = false;
         let mut g = match self.kernel {
-            // SAFETY: the features were just detected on this CPU.
-            #[cfg(target_arch = "x86_64")]
-            _ if fast => unsafe { self.gradient_avx2(q) },
             // φ'(r)/r: 1/r for φ = r, 3r for φ = r³.
             Kernel::Linear => self.gradient_sum(q, |r2| 1.0 / r2.max(1e-300).sqrt()),
             Kernel::Cubic => self.gradient_sum(q, |r2| 3.0 * r2.sqrt()),
@@ -423,69 +419,6 @@ impl Rbf {
         for (r, row) in g.iter_mut().enumerate() {
             for (c, x) in row.iter_mut().enumerate() {
                 *x = (*x + self.affine[c][r]) / self.scale;
-            }
-        }
-        g
-    }
-
-    /// [`Rbf::gradient_sum`] with explicit 4-lane AVX2 (the fine stage's ~100k × 2k pairs).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn gradient_avx2(&self, q: Point3) -> [[f64; 3]; 3] {
-        use std::arch::x86_64::*;
-        let n = self.cx.len();
-        let (cx, cy, cz) = (&self.cx[..n], &self.cy[..n], &self.cz[..n]);
-        let (wx, wy, wz) = (&self.w[0][..n], &self.w[1][..n], &self.w[2][..n]);
-        let cubic = self.kernel == Kernel::Cubic;
-        let (qx, qy, qz) = (_mm256_set1_pd(q[0]), _mm256_set1_pd(q[1]), _mm256_set1_pd(q[2]));
-        let mut acc = [[_mm256_setzero_pd(); 3]; 3];
-        let (one, tiny, three) = (_mm256_set1_pd(1.0), _mm256_set1_pd(1e-300), _mm256_set1_pd(3.0));
-        let chunks = n / 4;
-        for c in 0..chunks {
-            let j = c * 4;
-            // SAFETY: j + 4 ≤ n for every slice (all have length n).
-            let d = [
-                _mm256_sub_pd(qx, _mm256_loadu_pd(cx.as_ptr().add(j))),
-                _mm256_sub_pd(qy, _mm256_loadu_pd(cy.as_ptr().add(j))),
-                _mm256_sub_pd(qz, _mm256_loadu_pd(cz.as_ptr().add(j))),
-            ];
-            let r2 = _mm256_fmadd_pd(d[2], d[2], _mm256_fmadd_pd(d[1], d[1], _mm256_mul_pd(d[0], d[0])));
-            let f = if cubic {
-                _mm256_mul_pd(three, _mm256_sqrt_pd(r2))
-            } else {
-                _mm256_div_pd(one, _mm256_sqrt_pd(_mm256_max_pd(r2, tiny)))
-            };
-            let a = [
-                _mm256_mul_pd(f, _mm256_loadu_pd(wx.as_ptr().add(j))),
-                _mm256_mul_pd(f, _mm256_loadu_pd(wy.as_ptr().add(j))),
-                _mm256_mul_pd(f, _mm256_loadu_pd(wz.as_ptr().add(j))),
-            ];
-            for r in 0..3 {
-                for k in 0..3 {
-                    acc[r][k] = _mm256_fmadd_pd(a[r], d[k], acc[r][k]);
-                }
-            }
-        }
-        let hsum = |v: __m256d| {
-            let mut a = [0.0f64; 4];
-            _mm256_storeu_pd(a.as_mut_ptr(), v);
-            (a[0] + a[1]) + (a[2] + a[3])
-        };
-        let mut g = [[0.0f64; 3]; 3];
-        for r in 0..3 {
-            for k in 0..3 {
-                g[r][k] = hsum(acc[r][k]);
-            }
-        }
-        for j in chunks * 4..n {
-            let d = [q[0] - cx[j], q[1] - cy[j], q[2] - cz[j]];
-            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            let f = if cubic { 3.0 * r2.sqrt() } else { 1.0 / r2.max(1e-300).sqrt() };
-            let a = [wx[j] * f, wy[j] * f, wz[j] * f];
-            for r in 0..3 {
-                for k in 0..3 {
-                    g[r][k] += a[r] * d[k];
-                }
             }
         }
         g
