@@ -331,6 +331,15 @@ pub fn run(
             format!("{} takes {lo}..={hi} meshes, got {}", kind.name(), inputs.len()),
         ));
     }
+    // Every job but `convert` squares lengths; finite coordinates whose squares overflow would come
+    // out as degenerate faces, an empty mesh or an internal error, so they are refused here, once
+    // for all formats (the readers refuse NaN and infinity themselves, naming the line or accessor).
+    // `convert` only rewrites the numbers, exactly.
+    if kind != JobKind::Convert {
+        for m in &inputs {
+            m.check_coordinate_range()?;
+        }
+    }
     match kind {
         JobKind::Validate => crate::validate::run(&inputs[0], &parse_params(params)?, progress),
         JobKind::Convert => {

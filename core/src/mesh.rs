@@ -186,6 +186,11 @@ pub fn fan_of(f: &[u32], apex: usize, mut emit: impl FnMut([u32; 3])) {
     }
 }
 
+/// The largest coordinate magnitude a job accepts (`convert` excepted). Jobs square lengths (areas, distances in the
+/// spatial index, normal equations); past ~1e154 a square overflows to infinity and a valid mesh
+/// would come out as degenerate faces or empty. 1e150 leaves room for sums of squares.
+pub const MAX_COORDINATE: f64 = 1e150;
+
 /// A polygon mesh with optional per-vertex attributes, named face groups and polylines.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
@@ -222,6 +227,23 @@ impl Mesh {
     /// Name of a group id ("" when the mesh has no names).
     pub fn group_name(&self, id: u32) -> &str {
         self.groups.get(id as usize).map(String::as_str).unwrap_or("")
+    }
+
+    /// Refuses coordinates beyond ±[`MAX_COORDINATE`] (finite, but their squares overflow), naming
+    /// the first vertex. A policy on job inputs, not a structural invariant: `job::run` calls it
+    /// for every job but `convert`; readers and [`Mesh::check`] do not.
+    pub fn check_coordinate_range(&self) -> Result<()> {
+        if let Some(i) = self.positions.iter().position(|p| p.iter().any(|c| c.abs() > MAX_COORDINATE)) {
+            let c = self.positions[i].iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            return Err(Error::InvalidMesh {
+                location: Location::Vertex(i),
+                message: format!(
+                    "coordinate {c:e} is beyond ±{MAX_COORDINATE:e}: squared lengths and areas would \
+                     overflow; rescale the mesh"
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Checks the structural invariants a reader must establish: indices in range, attribute

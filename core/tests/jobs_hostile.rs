@@ -56,6 +56,7 @@ fn hostile() -> Vec<(&'static str, Mesh)> {
         ("inconsistent orientation", tris(sq.clone(), &[[0, 1, 2], [0, 3, 2]])),
         ("sphere at 1e-30", scaled(icosphere(1, 1.0), 1e-30)),
         ("sphere at 1e30", scaled(icosphere(1, 1.0), 1e30)),
+        ("sphere at 1e200 (squares overflow)", scaled(icosphere(1, 1.0), 1e200)),
         ("quad grid", grid(3, 3, 1.0, true)),
         ("torus", torus(8, 6, 1.0, 0.3, false)),
     ];
@@ -198,6 +199,7 @@ fn fit_never_panics_on_hostile_templates_or_curves() {
             curve_mesh(&[vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]]),
         ),
         ("tiny circles", curve_mesh(&[circle(0.0, 1e-12, 24), circle(1e-12, 1e-12, 24)])),
+        ("curves at 1e200", curve_mesh(&[circle(1e200, 1.0, 24), circle(1e200, 0.8, 24)])),
     ];
     for (what, curves) in hostile_curves {
         check_job(what, JobKind::Fit, vec![sphere.clone(), curves], json!({}), &mut failures);
@@ -262,4 +264,46 @@ fn random_meshes_never_panic() {
         );
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Finite coordinates whose squares overflow: a valid tetrahedron at 1e300 came out of `repair` as an
+/// empty mesh (no error) and out of `fit` as an internal error. Read from every text format, every
+/// job but `convert` refuses it, naming the vertex; `convert` keeps the number exactly.
+#[test]
+fn coordinates_whose_squares_overflow_are_refused_by_jobs_from_every_format() {
+    use meshwork_core::io::{self, ReadOptions};
+    let v = ["0 0 0", "1 0 0", "0 1e300 0", "0 0 1"];
+    let obj = format!("{}\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n", v.map(|p| format!("v {p}")).join("\n"));
+    let off = format!("OFF\n4 4 0\n{}\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n", v.join("\n"));
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n{}\n3 0 2 1\n",
+        v.join("\n")
+    );
+    let stl = format!(
+        "solid t\nfacet normal 0 0 0\nouter loop\nvertex {}\nvertex {}\nvertex {}\nendloop\nendfacet\nendsolid t\n",
+        v[0], v[2], v[1]
+    );
+    for (name, text) in [("obj", obj), ("off", off), ("ply", ply), ("stl", stl)] {
+        let mesh = io::read(text.as_bytes(), &ReadOptions::default()).expect(name).mesh;
+        for (kind, params) in single_mesh_jobs() {
+            if kind == JobKind::Convert {
+                let out = run(kind, vec![mesh.clone()], params, &Progress::new()).expect("convert");
+                assert!(out.meshes[0].positions.iter().any(|p| p[1] == 1e300), "{name}: convert");
+                continue;
+            }
+            let e = run(kind, vec![mesh.clone()], params.clone(), &Progress::new())
+                .expect_err(&format!("{name}: {} {params} must refuse 1e300", kind.name()));
+            let msg = e.to_string();
+            assert!(matches!(e, Error::InvalidMesh { .. }), "{name}: {msg}");
+            assert!(
+                msg.contains("1e300") && msg.contains("rescale") && msg.contains("vertex"),
+                "{name}: {msg}"
+            );
+        }
+    }
+    // The bound itself is accepted.
+    let ok = "v 0 0 0\nv 1 0 0\nv 0 1e150 0\nf 1 2 3\n";
+    let mesh = io::read(ok.as_bytes(), &ReadOptions::default()).unwrap().mesh;
+    assert!(run(JobKind::Repair, vec![mesh], json!({}), &Progress::new()).is_ok());
 }

@@ -399,7 +399,7 @@ fn snap_pairs(
             return Err(Error::params(format!("pairs[{i}].curve_point"), "coordinate is NaN or infinite"));
         }
         // A point so far away that its squared distance overflows (1e300) has no nearest vertex
-        // in the tree: it is as far as can be, the same error.
+        // in the tree: it is as far as can be, the same error ("far from every curve vertex").
         let nearest = tree.nearest(p.curve_point).filter(|&(_, d2)| d2.sqrt() <= limit);
         let Some((cp, d2)) = nearest else {
             let d = net.points.iter().map(|&q| dist(q, p.curve_point)).fold(f64::INFINITY, f64::min);

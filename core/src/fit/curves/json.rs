@@ -43,9 +43,12 @@ fn parse_polylines(lines: &serde_json::Value) -> Result<Mesh> {
                 .as_array()
                 .filter(|c| c.len() == 3)
                 .and_then(|c| Some([c[0].as_f64()?, c[1].as_f64()?, c[2].as_f64()?]))
-                .filter(|c| c.iter().all(|v| v.is_finite()))
+                .filter(|c| c.iter().all(|v| v.is_finite() && v.abs() <= crate::mesh::MAX_COORDINATE))
                 .ok_or_else(|| {
-                    at(format!("polylines[{i}][{j}]"), "a point is [x, y, z] with finite numbers")
+                    at(
+                        format!("polylines[{i}][{j}]"),
+                        "a point is [x, y, z] with finite numbers within ±1e150",
+                    )
                 })?;
             let index = u32::try_from(mesh.positions.len())
                 .map_err(|_| at(format!("polylines[{i}]"), "too many points"))?;
@@ -72,6 +75,14 @@ mod json_tests {
         assert_eq!(m.curves, vec![vec![0, 1, 2], vec![3, 4]]);
         assert_eq!(m.positions[4], [0.0, 1.0, 0.5]);
         assert_eq!(m.face_count(), 0);
+    }
+
+    #[test]
+    fn polylines_json_refuses_coordinates_whose_squares_overflow() {
+        let e = polylines_from_json(br#"{"polylines": [[[0,0,0],[1,0,0]], [[0,0,0],[0,1e200,0]]]}"#)
+            .unwrap()
+            .unwrap_err();
+        assert!(e.to_string().contains("polylines[1][1]"), "{e}");
     }
 
     #[test]
