@@ -96,11 +96,13 @@ fn main() {
                         }
                         let ok = r["flipped_faces"] == 0 && r["segments_as_edges"] == 1.0;
                         println!(
-                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {}",
+                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {} fine surface {} inverted {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {}",
                             if ok { "ok " } else { "BAD" },
                             r["flipped_faces"],
                             r["flipped_faces_after_fine"],
                             r["flipped_faces_before_smoothing"],
+                            r["flipped_faces_against_fine_surface"],
+                            r["faces_inverted_by_maps"],
                             r["segments_as_edges"].as_f64().unwrap_or(0.0),
                             r["regions"],
                             r["folded_edges"],

@@ -201,11 +201,17 @@ fn main() {
                         );
                     }
                     println!(
-                        "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>6} {:>6} {:>8.2} {:>4}/{:<4} {:>6} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
+                        "{name:<16} {label:<6} {:>6} {:>6} {:>7.2} {:>9} {:>6} {:>8.2} {:>4}/{:<4} {:>6} {:>9.2e} {:>4.1}/{:<4.1} {:>3}/{:<3}",
                         template.positions.len(),
                         curves.positions.len(),
                         secs,
-                        format!("{}/{}", r["flipped_faces_before_smoothing"], r["flipped_faces"]),
+                        // before smoothing / final (the final count against the fine surface, the measure before session 13)
+                        format!(
+                            "{}/{}({})",
+                            r["flipped_faces_before_smoothing"],
+                            r["flipped_faces"],
+                            r["flipped_faces_against_fine_surface"]
+                        ),
                         // Reference-free folded edges (output; the template's own in brackets).
                         format!("{}({})", r["folded_edges"], r["folds"]["template"]["folded_edges"]),
                         100.0 * r["segments_as_edges"].as_f64().unwrap_or(f64::NAN),

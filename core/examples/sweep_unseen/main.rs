@@ -181,12 +181,14 @@ fn main() {
                     _ => format!("BAD {}", bad.join("; ")),
                 };
                 format!(
-                    "{status} | regions {} faces {}→{} edges {} flips {} resid {:.1e} angle {:.1}/{:.1} net {}",
+                    "{status} | regions {} faces {}→{} edges {} flips {} (fine surface {}, inverted {}) resid {:.1e} angle {:.1}/{:.1} net {}",
                     r["regions"],
                     r["template_triangles"],
                     r["output_faces"],
                     r["segments_as_edges"],
                     r["flipped_faces"],
+                    r["flipped_faces_against_fine_surface"],
+                    r["faces_inverted_by_maps"],
                     r["curve_residual_max_relative"].as_f64().unwrap_or(f64::NAN),
                     r["min_angle_deg_before_smoothing"].as_f64().unwrap_or(f64::NAN),
                     r["min_angle_deg_after_smoothing"].as_f64().unwrap_or(f64::NAN),

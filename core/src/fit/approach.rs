@@ -92,6 +92,7 @@ pub fn approach(
     levels: usize,
     max_distance: f64,
     rim_feet: bool,
+    orientation: &mut super::orientation::Orientation,
     progress: &Progress,
 ) -> Result<ApproachReport> {
     let mut report = ApproachReport::default();
@@ -181,6 +182,8 @@ pub fn approach(
             continue;
         }
         let Ok(field) = Rbf::fit(&centres, &values, kernel, "fine") else { continue };
+        // Shared with the orientation count, which may evaluate its Jacobian again exactly.
+        let field = std::sync::Arc::new(field);
         let mut disp = field.eval_many(pos, progress)?;
         let targets: Vec<Point3> = sample.iter().map(|&p| net.points[p as usize]).collect();
         let refined = super::field_refine::refine_for_field(
@@ -203,6 +206,9 @@ pub fn approach(
             report.step.push(0.0);
             continue;
         }
+        // The template's normals through this level's map, x ↦ x + step · s(x).
+        orientation.sync(parents);
+        orientation.push_field(pos, field.clone(), step, progress)?;
         pos.copy_from_slice(&moved);
         for &(p, v) in fixed {
             pos[v as usize] = net.points[p as usize];

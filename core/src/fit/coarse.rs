@@ -8,6 +8,7 @@ use crate::geometry::{add, dist, sub, Aabb};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
+use super::orientation::{mat_mul, Orientation};
 use super::{align, curves, kdtree, rbf, Alignment, CoplanarCentres, FitPair, FitParams};
 
 /// What the coarse stage did (serialised into the report).
@@ -72,6 +73,7 @@ pub(super) fn coarse_alignment(
     tris: &[[u32; 3]],
     net: &curves::CurveNetwork,
     params: &FitParams,
+    orientation: &mut Orientation,
     progress: &Progress,
 ) -> Result<CoarseReport> {
     let use_pairs = match params.alignment {
@@ -82,7 +84,7 @@ pub(super) fn coarse_alignment(
     if use_pairs {
         let (fixed, snap_max) = snap_pairs(&params.pairs, pos.len(), net, params.max_curve_distance)?;
         if params.coplanar_centres == CoplanarCentres::Augment && pairs_on_a_line(pos, &fixed, net) {
-            return pairs_similarity(pos, tris, net, &fixed, snap_max, progress);
+            return pairs_similarity(pos, tris, net, &fixed, snap_max, orientation, progress);
         }
         let centres: Vec<Point3> = fixed.iter().map(|&(_, v)| pos[v as usize]).collect();
         let values: Vec<Point3> =
@@ -90,6 +92,7 @@ pub(super) fn coarse_alignment(
         let name = |i: usize| format!("pairs[{i}] (template vertex {})", params.pairs[i].template_vertex);
         let f = fit_rbf(centres, values, params, "coarse", "pairs", &name, progress)?;
         let disp = f.eval_many(pos, progress)?;
+        orientation.push(pos, |_, p| plus_identity(f.gradient(p)));
         for (p, d) in pos.iter_mut().zip(disp) {
             *p = add(*p, d);
         }
@@ -119,7 +122,16 @@ pub(super) fn coarse_alignment(
             warning: None,
         });
     }
-    automatic(pos, tris, net, progress)
+    automatic(pos, tris, net, orientation, progress)
+}
+
+/// I + g: the Jacobian of x ↦ x + s(x) from the field's gradient g.
+pub(super) fn plus_identity(g: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut j = g;
+    for (k, row) in j.iter_mut().enumerate() {
+        row[k] += 1.0;
+    }
+    j
 }
 
 /// No pairs: PCA + similarity ICP, then the smooth warp from every contender pose (ICP score
@@ -138,6 +150,7 @@ fn automatic(
     pos: &mut [Point3],
     tris: &[[u32; 3]],
     net: &curves::CurveNetwork,
+    orientation: &mut Orientation,
     progress: &Progress,
 ) -> Result<CoarseReport> {
     let rim = Rim::new(tris, net, progress)?;
@@ -171,6 +184,9 @@ fn automatic(
     let Some((chosen, Some((warped, warp, best, _)))) = tried.first().cloned() else {
         return Err(Error::Internal("automatic alignment found no pose".into()));
     };
+    // The template's normals through the chosen similarity and its warp.
+    let sim = chosen.sim.jacobian();
+    orientation.push(pos, |_, p| mat_mul(&warp.map.jacobian(chosen.sim.apply(p)), &sim));
     pos.copy_from_slice(&warped);
     let candidates: Vec<CandidateReport> = tried
         .iter()
@@ -334,15 +350,19 @@ fn pairs_similarity(
     net: &curves::CurveNetwork,
     fixed: &[(u32, u32)],
     snap_max: f64,
+    orientation: &mut Orientation,
     progress: &Progress,
 ) -> Result<CoarseReport> {
     let pairs: Vec<(Point3, Point3)> =
         fixed.iter().map(|&(p, v)| (pos[v as usize], net.points[p as usize])).collect();
     let (sim, rms) = align::pairs_icp(pos, &net.points, &pairs, 30, progress)?;
+    orientation.push(pos, |_, _| sim.jacobian());
     for p in pos.iter_mut() {
         *p = sim.apply(*p);
     }
+    let before_warp = pos.to_vec();
     let warp = warp_to_curves(pos, tris, net, None, progress)?;
+    orientation.push(&before_warp, |_, p| warp.map.jacobian(p));
     Ok(CoarseReport {
         method: "pairs_similarity",
         pair_curve_points: fixed.iter().map(|x| x.0).collect(),

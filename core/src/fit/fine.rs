@@ -10,6 +10,8 @@ use crate::mesh::Point3;
 
 use super::coarse::{fit_rbf, CoarseReport};
 use super::insert::coincident;
+use super::orientation::Orientation;
+use super::rbf::Rbf;
 use super::{approach, correspond, curves, flips, insert, FitParams, Matching};
 
 /// The fine stage's result.
@@ -114,14 +116,21 @@ pub(super) fn fine_dispatch(
     template_diag: f64,
     parents: &mut Vec<[(u32, f64); 3]>,
     search: insert::FootSearch,
+    orientation: &mut Orientation,
     progress: &Progress,
 ) -> Result<Fine> {
-    match params.matching {
+    let (fine, field) = match params.matching {
         Matching::Insert => {
-            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)
+            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)?
         }
-        Matching::NearestVertex => fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress),
-    }
+        Matching::NearestVertex => {
+            fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress)?
+        }
+    };
+    // The template's normals through the fine RBF, at every vertex the stage kept.
+    orientation.sync(parents);
+    orientation.push_field(pos, std::sync::Arc::new(field), 1.0, progress)?;
+    Ok(fine)
 }
 
 /// The fine stage with `Matching::Insert`: split the template at the curve vertices' feet, solve
@@ -138,7 +147,7 @@ fn fine_fit_inserted(
     parents: &mut Vec<[(u32, f64); 3]>,
     search: insert::FootSearch,
     progress: &Progress,
-) -> Result<Fine> {
+) -> Result<(Fine, Rbf)> {
     let pair_fixed = coarse.pair_fixed(&params.pairs);
     let clock = std::time::Instant::now();
     let mut steps_ms = [0.0; 4];
@@ -215,7 +224,7 @@ fn fine_fit_inserted(
     }
     lap(3);
     let n = distances.len().max(1) as f64;
-    Ok(Fine {
+    let fine = Fine {
         positions: moved,
         vertex_of_point: vop,
         report: FineReport {
@@ -236,7 +245,8 @@ fn fine_fit_inserted(
             approach: None,
             approach_ms: 0.0,
         },
-    })
+    };
+    Ok((fine, f))
 }
 
 /// The template's UVs extended to the vertices the fit added (each a weighted combination of
@@ -266,13 +276,13 @@ fn fine_fit(
     template_diag: f64,
     parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
-) -> Result<Fine> {
+) -> Result<(Fine, Rbf)> {
     let pair_fixed = coarse.pair_fixed(&params.pairs);
     let nv0 = pos.len() - parents.len();
     let mut flagged_per_round = Vec::new();
     let mut faces_added = 0;
     let budget = tris.len(); // subdivision may at most double the face count
-    let mut best: Option<(Fine, Vec<Point3>, Vec<[u32; 3]>)> = None;
+    let mut best: Option<(Fine, Vec<Point3>, Vec<[u32; 3]>, Rbf)> = None;
     for round in 0..=params.max_flip_iterations {
         progress.check()?;
         let corr = correspond::closest(pos, net, &pair_fixed, progress)?;
@@ -321,7 +331,7 @@ fn fine_fit(
         let matched_now = fine.vertex_of_point.clone();
         let improves = best.as_ref().is_none_or(|b| fine.report.flipped_faces < b.0.report.flipped_faces);
         if improves {
-            best = Some((fine, pos.clone(), tris.clone()));
+            best = Some((fine, pos.clone(), tris.clone(), f));
         }
         let done = flagged.is_empty()
             || !improves
@@ -336,12 +346,12 @@ fn fine_fit(
         let split = flips::with_matched_stars(tris, &flagged, &matched_now);
         faces_added += flips::subdivide(pos, tris, &split, parents);
     }
-    if let Some((mut fine, p, t)) = best {
+    if let Some((mut fine, p, t, f)) = best {
         parents.truncate(p.len() - nv0);
         *pos = p;
         *tris = t;
         fine.report.flagged_per_round = flagged_per_round;
-        return Ok(fine);
+        return Ok((fine, f));
     }
     Err(Error::Internal("flip loop ended without a result".into()))
 }

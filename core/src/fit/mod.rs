@@ -118,9 +118,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     })?;
     let given_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
+    // The template's normals, pushed forward by every map the coarse and fine stages apply: the
+    // report's reference for turned faces ([`orientation`]).
+    let mut orientation = orientation::Orientation::new(&template.positions, &template_tris);
 
-    let mut coarse =
-        stages.run(progress, "coarse", || coarse_alignment(&mut pos, &tris, &net, params, progress))?;
+    let mut coarse = stages.run(progress, "coarse", || {
+        coarse_alignment(&mut pos, &tris, &net, params, &mut orientation, progress)
+    })?;
     // Crossings and T-junctions the network joined are checked against the aligned template:
     // curves on two pieces, or on two sheets of a self-intersecting template, are not joined (the
     // network is built again).
@@ -169,6 +173,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             levels,
             limit,
             params.thin_rim_feet,
+            &mut orientation,
             progress,
         )?;
         let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
@@ -201,6 +206,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             template_diag,
             &mut parents,
             search,
+            &mut orientation,
             progress,
         )?;
         fine.report.approach = Some(approach);
@@ -457,7 +463,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Vertices removed by the clean-up leave the output; every per-vertex array is renumbered.
     let removed: Vec<u32> =
         cleaned.removed_vertices.iter().chain(&degenerate.removed_vertices).copied().collect();
-    let keep = compact::Renumber::new(out_pos.len(), &removed);
+    let keep_len = out_pos.len();
+    let keep = compact::Renumber::new(keep_len, &removed);
     let out_tris: Vec<[u32; 3]> = out_tris.iter().map(|&t| keep.tri(t)).collect();
     for c in realised.chains.iter_mut() {
         keep.apply(c);
@@ -465,6 +472,15 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut vertex_of_point = fine.vertex_of_point.clone();
     keep.apply(&mut vertex_of_point);
     let reference_normals = keep.vec(&reference_normals);
+    // Vertices the re-triangulation and its untangling added take their parents' normals.
+    orientation.sync(&parents);
+    if orientation.len() != keep_len {
+        return Err(Error::Internal(format!(
+            "fit: {} pushed-forward normals for {keep_len} vertices (a vertex added without parents)",
+            orientation.len()
+        )));
+    }
+    let orientation = orientation.renumbered(&keep);
     let fine_positions = keep.vec(&fine_positions);
     let out_pos = keep.vec(&out_pos);
 
@@ -525,6 +541,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &out_tris,
             &fine_positions,
             &reference_normals,
+            &orientation,
         ))
     })?;
     let folds = untangle::fold_stats(&out.positions, &out_tris);
@@ -589,6 +606,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Reference-free: adjacent faces folded back onto each other (untangle::fold_stats). Added
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
+    report["flipped_faces_against_fine_surface"] = quality.flipped_faces_against_fine_surface.into();
+    report["faces_inverted_by_maps"] = quality.faces_inverted_by_maps.into();
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;

@@ -27,10 +27,17 @@
 //! template face its corners share, so an untouched or subdivided template face is compared with
 //! its own normal (vertex normals are ambiguous at creases and thin fins).
 
+use std::collections::HashMap;
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
+use crate::error::Result;
 use crate::geometry::{add, cross, dot, normalize, scale, triangle_cross};
+use crate::job::Progress;
 use crate::mesh::Point3;
+
+use super::rbf::Rbf;
 
 /// A 3×3 Jacobian: `j[r][c]` = ∂(output r)/∂(input c).
 pub type Jacobian = [[f64; 3]; 3];
@@ -51,11 +58,36 @@ enum Place {
     Across,
 }
 
-/// Per working vertex of the fit: the composite Jacobian of every map applied so far, and where
-/// on the template the vertex lies.
-#[derive(Debug, Clone)]
+/// A map whose Jacobians were summed in single precision ([`Orientation::push_field`]): what it
+/// takes to evaluate them again exactly.
+#[derive(Clone)]
+enum Step {
+    /// x ↦ x + step · field(x), from the positions `before` it.
+    Field { field: Arc<Rbf>, step: f64, before: Vec<Point3> },
+    /// An exact map after a bounded one: its Jacobian per vertex.
+    Exact(Vec<Jacobian>),
+}
+
+/// From the first bounded map on, what re-evaluating a vertex's composite Jacobian exactly takes:
+/// the composite before that map, every map since, and the lineage of the vertices added since.
+#[derive(Clone)]
+struct Replay {
+    origin: Vec<Jacobian>,
+    steps: Vec<Step>,
+    /// Per vertex added after `origin`: its parents and how many `steps` it had then.
+    added: Vec<([(u32, f64); 3], usize)>,
+    /// False once a rollback removed a vertex older than the first bounded map (no caller does):
+    /// faces the bounds leave open are then decided by their approximate Jacobians.
+    valid: bool,
+}
+
+/// Per working vertex of the fit: the composite Jacobian of every map applied so far, a bound on
+/// its error, and where on the template the vertex lies.
+#[derive(Clone)]
 pub struct Orientation {
     jacobians: Vec<Jacobian>,
+    /// Frobenius-norm bound on each Jacobian's error (0 while every map was exact).
+    errors: Vec<f64>,
     places: Vec<Place>,
     /// The template's unit face normals and area-weighted vertex normals.
     face_normals: Vec<Point3>,
@@ -65,6 +97,9 @@ pub struct Orientation {
     vf: Vec<u32>,
     /// Vertices with an index below this are the template's; vertex `base + i` has `parents[i]`.
     base: usize,
+    replay: Option<Replay>,
+    /// Each vertex's index when the maps were pushed (identity until [`Orientation::renumbered`]).
+    working: Option<Vec<u32>>,
 }
 
 /// `cof(J)·n` and `det J`: with the columns a, b, c of J, cof(J) = [b×c, c×a, a×b].
@@ -91,6 +126,40 @@ fn det(j: &Jacobian) -> f64 {
     cofactor_times(j, [0.0; 3]).1
 }
 
+fn frobenius(j: &Jacobian) -> f64 {
+    j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// I + step · g: the Jacobian of x ↦ x + step · s(x) from the field's gradient g.
+fn field_step(g: &Jacobian, step: f64) -> Jacobian {
+    std::array::from_fn(|r| std::array::from_fn(|c| step * g[r][c] + if r == c { 1.0 } else { 0.0 }))
+}
+
+/// One corner of a face: its pushed-forward normal and how far the Jacobian's error bound `e`
+/// could move it (2, the most a unit vector can move, where the sign of det J or the direction is
+/// open). Bounds for ‖ΔJ‖_F ≤ e: cof(J)·n = (J·a)×(J·b) for orthonormal a, b with a×b = n, so it
+/// moves by at most 2(‖J‖ + e)e; det J, a triple product of columns, by at most 3(‖J‖ + e)²e;
+/// and a unit vector c/|c| by at most 2|Δc|/|c|.
+fn corner(j: &Jacobian, e: f64, n: Point3) -> (Point3, f64) {
+    let (c, d) = cofactor_times(j, n);
+    let unit = normalize(if d > 0.0 { c } else { scale(c, -1.0) });
+    if e == 0.0 || dot(n, n) == 0.0 {
+        return (unit, 0.0);
+    }
+    let f = frobenius(j) + e;
+    let (dc, dd, len) = (2.0 * f * e, 3.0 * f * f * e, dot(c, c).sqrt());
+    let open = !(d.abs() > dd && len > 2.0 * dc);
+    (unit, if open { 2.0 } else { 2.0 * dc / len })
+}
+
+/// A face's orientation against its reference: decided either way, or left open by the bounds.
+#[derive(Clone, Copy, PartialEq)]
+enum Decision {
+    Against,
+    With,
+    Open,
+}
+
 impl Orientation {
     /// The template (positions, triangles), no map applied yet.
     pub fn new(template_pos: &[Point3], template_tris: &[[u32; 3]]) -> Orientation {
@@ -114,6 +183,7 @@ impl Orientation {
         }
         Orientation {
             jacobians: vec![IDENTITY; nv],
+            errors: vec![0.0; nv],
             places: (0..nv as u32).map(Place::Vertex).collect(),
             face_normals: template_tris
                 .iter()
@@ -129,6 +199,8 @@ impl Orientation {
             vf_start,
             vf,
             base: nv,
+            replay: None,
+            working: None,
         }
     }
 
@@ -140,6 +212,35 @@ impl Orientation {
             }
             Place::Face(_) | Place::Edge(..) | Place::Across => &[],
         }
+    }
+
+    /// Whether template face `f` is at place `p`.
+    fn touches(&self, p: Place, f: u32) -> bool {
+        match p {
+            Place::Vertex(_) => self.faces_of(p).contains(&f),
+            Place::Face(g) => g == f,
+            Place::Edge(g, h) => g == f || h == f,
+            Place::Across => false,
+        }
+    }
+
+    /// The first template face common to all three places (in the first place's order), without
+    /// allocating: this runs for every output face.
+    fn shared_face(&self, places: [Place; 3]) -> Option<u32> {
+        let pair;
+        let candidates: &[u32] = match places[0] {
+            Place::Vertex(_) => self.faces_of(places[0]),
+            Place::Face(f) => {
+                pair = [f, f];
+                &pair[..1]
+            }
+            Place::Edge(f, g) => {
+                pair = [f, g];
+                &pair
+            }
+            Place::Across => return None,
+        };
+        candidates.iter().copied().find(|&f| self.touches(places[1], f) && self.touches(places[2], f))
     }
 
     /// The template faces common to all `places` (small lists: a vertex's faces at most).
@@ -168,12 +269,23 @@ impl Orientation {
     /// dropped again.
     pub fn sync(&mut self, parents: &[[(u32, f64); 3]]) {
         let want = self.base + parents.len();
-        self.jacobians.truncate(want);
-        self.places.truncate(want);
+        if want < self.jacobians.len() {
+            self.jacobians.truncate(want);
+            self.errors.truncate(want);
+            self.places.truncate(want);
+            if let Some(r) = self.replay.as_mut() {
+                match want.checked_sub(r.origin.len()) {
+                    Some(k) => r.added.truncate(k),
+                    None => r.valid = false,
+                }
+            }
+        }
         for p in &parents[self.jacobians.len() - self.base..] {
             let used = || p.iter().filter(|x| x.1 > 0.0);
-            // The composite map is smooth: its Jacobian between two vertices is their blend.
+            // The composite map is smooth: its Jacobian between two vertices is their blend (and
+            // the blend's error at most the blend of the errors, the weights being positive).
             let mut j = [[0.0; 3]; 3];
+            let mut e = 0.0;
             for &(v, w) in used() {
                 let jv = &self.jacobians[v as usize];
                 for r in 0..3 {
@@ -181,6 +293,7 @@ impl Orientation {
                         j[r][c] += w * jv[r][c];
                     }
                 }
+                e += w * self.errors[v as usize];
             }
             let first = used().next().map(|x| self.places[x.0 as usize]);
             let place = if used().all(|x| Some(self.places[x.0 as usize]) == first) {
@@ -194,7 +307,11 @@ impl Orientation {
                 }
             };
             self.jacobians.push(j);
+            self.errors.push(e);
             self.places.push(place);
+            if let Some(r) = self.replay.as_mut() {
+                r.added.push((*p, r.steps.len()));
+            }
         }
     }
 
@@ -212,13 +329,57 @@ impl Orientation {
     pub fn push(&mut self, before: &[Point3], jacobian: impl Fn(usize, Point3) -> Jacobian + Sync) -> usize {
         debug_assert_eq!(before.len(), self.jacobians.len());
         let n = before.len().min(self.jacobians.len());
-        self.jacobians[..n]
+        let steps: Vec<Jacobian> = before[..n].par_iter().enumerate().map(|(v, &p)| jacobian(v, p)).collect();
+        let inverted = self.apply(&steps, |_| 0.0);
+        if let Some(r) = self.replay.as_mut() {
+            r.steps.push(Step::Exact(steps));
+        }
+        inverted
+    }
+
+    /// Composes every vertex's Jacobian with the map x ↦ x + step · field(x), the field's
+    /// gradients summed in single precision with error bounds ([`Rbf::gradients_bounded`]): the
+    /// fit's RBF maps, ~100k vertices × ~2k centres each. Keeps what the count needs to evaluate
+    /// them again exactly where a face's decision is open. Returns how many vertices the map
+    /// inverts by the single-precision values.
+    pub fn push_field(
+        &mut self,
+        before: &[Point3],
+        field: Arc<Rbf>,
+        step: f64,
+        progress: &Progress,
+    ) -> Result<usize> {
+        let n = before.len().min(self.jacobians.len());
+        let grads = field.gradients_bounded(&before[..n], progress)?;
+        let steps: Vec<Jacobian> = grads.par_iter().map(|(g, _)| field_step(g, step)).collect();
+        if self.replay.is_none() {
+            self.replay = Some(Replay {
+                origin: self.jacobians.clone(),
+                steps: Vec::new(),
+                added: Vec::new(),
+                valid: true,
+            });
+        }
+        let inverted = self.apply(&steps, |v| step.abs() * grads[v].1);
+        if let Some(r) = self.replay.as_mut() {
+            r.steps.push(Step::Field { field, step, before: before[..n].to_vec() });
+        }
+        Ok(inverted)
+    }
+
+    /// Multiplies every vertex's Jacobian by its step on the left; `bound(v)`: the step's error
+    /// bound (‖ΔĴ'‖ ≤ b‖Ĵ‖ + (‖Ŝ‖ + b)·e for Ĵ' = Ŝ·Ĵ). Returns the steps with det ≤ 0.
+    fn apply(&mut self, steps: &[Jacobian], bound: impl Fn(usize) -> f64 + Sync) -> usize {
+        self.jacobians
             .par_iter_mut()
+            .zip(self.errors.par_iter_mut())
+            .zip(steps.par_iter())
             .enumerate()
-            .map(|(v, j)| {
-                let step = jacobian(v, before[v]);
-                *j = mat_mul(&step, j);
-                let d = det(&step);
+            .map(|(v, ((j, e), s))| {
+                let b = bound(v);
+                *e = b * frobenius(j) + (frobenius(s) + b) * *e;
+                *j = mat_mul(s, j);
+                let d = det(s);
                 (d <= 0.0 || !d.is_finite()) as usize
             })
             .sum()
@@ -235,47 +396,160 @@ impl Orientation {
         }
     }
 
-    /// Per face: the template's normal where the face lies, pushed forward by the maps at its
-    /// corners, summed. A face whose corners share a template face uses that face's normal at
-    /// every corner (no vertex normal, which is ambiguous at a crease or a thin fin: 21 of
-    /// suzanne's 968 faces oppose their own corners' vertex normals).
-    fn reference(&self, t: &[u32; 3]) -> Point3 {
+    /// The template normal each corner of a face carries: the normal of the template face its
+    /// corners share, at every corner (no vertex normal, which is ambiguous at a crease or a thin
+    /// fin: 21 of suzanne's 968 faces oppose their own corners' vertex normals), else its own
+    /// place's.
+    fn corner_normals(&self, t: &[u32; 3]) -> [Point3; 3] {
         let places = t.map(|v| self.places[v as usize]);
-        let shared = self.common_faces(places.iter().copied()).and_then(|c| c.first().copied());
-        let mut r = [0.0; 3];
-        for (k, &v) in t.iter().enumerate() {
-            let n = match shared {
-                Some(f) => self.face_normals[f as usize],
-                None => self.template_normal(places[k]),
-            };
-            r = add(r, push_normal(&self.jacobians[v as usize], n));
+        match self.shared_face(places) {
+            Some(f) => [self.face_normals[f as usize]; 3],
+            None => places.map(|p| self.template_normal(p)),
         }
-        r
     }
 
-    /// Faces whose normal opposes their reference ([`Orientation::reference`]).
+    /// A face against its reference, the sum over its corners of the template's normal pushed
+    /// forward, with each corner's Jacobian and error bound from `jac`: open when the bounds
+    /// could change the sign.
+    fn decide(&self, pos: &[Point3], t: &[u32; 3], jac: impl Fn(u32) -> (Jacobian, f64)) -> Decision {
+        let n = normalize(triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]));
+        if dot(n, n) == 0.0 {
+            // A zero-area face has no normal to oppose anything (counted elsewhere: `degenerate`).
+            return Decision::With;
+        }
+        let normals = self.corner_normals(t);
+        let (mut r, mut slack) = ([0.0; 3], 0.0);
+        for (k, &v) in t.iter().enumerate() {
+            let (j, e) = jac(v);
+            let (unit, moves) = corner(&j, e, normals[k]);
+            r = add(r, unit);
+            slack += moves;
+        }
+        let d = dot(n, r);
+        if slack > 0.0 && d.abs() <= slack {
+            Decision::Open
+        } else if d < 0.0 {
+            Decision::Against
+        } else {
+            Decision::With
+        }
+    }
+
+    /// Faces whose normal opposes their reference ([`Orientation::decide`]); those the error
+    /// bounds leave open are decided again with exact Jacobians ([`Orientation::exact`]).
     pub fn faces_against(&self, pos: &[Point3], tris: &[[u32; 3]]) -> usize {
-        tris.par_iter()
-            .filter(|t| {
-                let n = triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-                dot(n, self.reference(t)) < 0.0
-            })
-            .count()
+        let stored = |v: u32| (self.jacobians[v as usize], self.errors[v as usize]);
+        let decided: Vec<Decision> = tris.par_iter().map(|t| self.decide(pos, t, stored)).collect();
+        let mut against = decided.iter().filter(|&&d| d == Decision::Against).count();
+        let open: Vec<&[u32; 3]> =
+            tris.iter().zip(&decided).filter(|x| *x.1 == Decision::Open).map(|x| x.0).collect();
+        if !open.is_empty() {
+            let exact = self.exact_at(open.iter().flat_map(|t| t.iter().copied()));
+            for t in open {
+                let d = self.decide(pos, t, |v| exact(v));
+                // Without a replay (none is lost in the fit) the approximate sign decides.
+                let d = if d == Decision::Open { self.decide(pos, t, |v| (stored(v).0, 0.0)) } else { d };
+                against += (d == Decision::Against) as usize;
+            }
+        }
+        against
     }
 
-    /// Faces with at least two corners where the composite map turns space inside out (det J ≤ 0).
+    /// Faces with at least two corners where the composite map turns space inside out (det J ≤ 0),
+    /// corners whose sign the bound leaves open decided with exact Jacobians.
     pub fn faces_inverted(&self, tris: &[[u32; 3]]) -> usize {
-        tris.par_iter()
-            .filter(|t| t.iter().filter(|&&v| !(det(&self.jacobians[v as usize]) > 0.0)).count() >= 2)
-            .count()
+        // Per vertex: Some(inverted) when decided, None when open.
+        let sign = |j: &Jacobian, e: f64| {
+            let d = det(j);
+            let f = frobenius(j) + e;
+            (e == 0.0 || d.abs() > 3.0 * f * f * e).then_some(!(d > 0.0))
+        };
+        let per: Vec<Option<bool>> =
+            self.jacobians.par_iter().zip(&self.errors).map(|(j, &e)| sign(j, e)).collect();
+        let open: Vec<u32> = (0..per.len() as u32).filter(|&v| per[v as usize].is_none()).collect();
+        let exact = self.exact_at(open.iter().copied());
+        let inverted = |v: u32| match per[v as usize] {
+            Some(b) => b,
+            None => !(det(&exact(v).0) > 0.0),
+        };
+        tris.iter().filter(|t| t.iter().filter(|&&v| inverted(v)).count() >= 2).count()
+    }
+
+    /// Exact Jacobians (error 0) at `vertices`, replayed from the first bounded map (in parallel,
+    /// each vertex with its own memo: lineages rarely overlap); the stored approximation (with its
+    /// bound) where no replay is kept.
+    fn exact_at(&self, vertices: impl Iterator<Item = u32>) -> impl Fn(u32) -> (Jacobian, f64) + '_ {
+        let mut wanted: Vec<u32> = vertices.collect();
+        wanted.sort_unstable();
+        wanted.dedup();
+        let replay = self.replay.as_ref().filter(|r| r.valid);
+        let found: HashMap<u32, (Jacobian, f64)> = wanted
+            .par_iter()
+            .map(|&v| {
+                let stored = (self.jacobians[v as usize], self.errors[v as usize]);
+                let exact = replay.and_then(|r| {
+                    let w = self.working.as_ref().map_or(v, |m| m[v as usize]);
+                    replay_jacobian(r, w, r.steps.len(), &mut HashMap::new()).map(|j| (j, 0.0))
+                });
+                (v, exact.unwrap_or(stored))
+            })
+            .collect();
+        move |v| found.get(&v).copied().unwrap_or((self.jacobians[v as usize], self.errors[v as usize]))
     }
 
     /// The same, with only the vertices `keep` keeps (a renumbering after removals).
     pub fn renumbered(mut self, keep: &super::compact::Renumber) -> Orientation {
+        let working: Vec<u32> = match &self.working {
+            Some(w) => w.clone(),
+            None => (0..self.jacobians.len() as u32).collect(),
+        };
+        self.working = Some(keep.vec(&working));
         self.jacobians = keep.vec(&self.jacobians);
+        self.errors = keep.vec(&self.errors);
         self.places = keep.vec(&self.places);
         self
     }
+}
+
+/// Working vertex `v`'s composite Jacobian after the first `upto` steps of the replay, in f64:
+/// its origin (or its parents' blend when it was added), times each step since. None when the
+/// lineage does not reach (a vertex the replay does not know).
+fn replay_jacobian(
+    r: &Replay,
+    v: u32,
+    upto: usize,
+    memo: &mut HashMap<(u32, usize), Jacobian>,
+) -> Option<Jacobian> {
+    if let Some(j) = memo.get(&(v, upto)) {
+        return Some(*j);
+    }
+    let (mut j, from) = match r.origin.get(v as usize) {
+        Some(j) => (*j, 0),
+        None => {
+            let &(parents, epoch) = r.added.get(v as usize - r.origin.len())?;
+            let mut j = [[0.0; 3]; 3];
+            for &(p, w) in parents.iter().filter(|x| x.1 > 0.0) {
+                let jp = replay_jacobian(r, p, epoch, memo)?;
+                for row in 0..3 {
+                    for c in 0..3 {
+                        j[row][c] += w * jp[row][c];
+                    }
+                }
+            }
+            (j, epoch)
+        }
+    };
+    for step in &r.steps[from.min(upto)..upto] {
+        let s = match step {
+            Step::Field { field, step, before } => {
+                field_step(&field.gradient(*before.get(v as usize)?), *step)
+            }
+            Step::Exact(per_vertex) => *per_vertex.get(v as usize)?,
+        };
+        j = mat_mul(&s, &j);
+    }
+    memo.insert((v, upto), j);
+    Some(j)
 }
 
 #[cfg(test)]
@@ -390,6 +664,83 @@ mod tests {
         assert_eq!(o.faces_against(&at, &turned), 3);
         o.sync(&parents[..1]);
         assert_eq!(o.len(), 5);
+    }
+
+    /// A face with normal `n` at `at` (edge length 1e-3).
+    fn face_with_normal(at: Point3, n: Point3) -> [Point3; 3] {
+        let n = normalize(n);
+        let helper = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let a = normalize(cross(helper, n));
+        let b = cross(n, a);
+        [at, add(at, scale(a, 1e-3)), add(at, scale(b, 1e-3))]
+    }
+
+    /// A field map pushed in single precision ([`Orientation::push_field`]) counts exactly what
+    /// the same map pushed in f64 counts, also for faces whose normal is within 1e-10 of
+    /// perpendicular to their reference (the bounds leave those open and the count replays them
+    /// exactly), and for faces on vertices added between two maps (replayed through their
+    /// parents) and after the last (blended).
+    #[test]
+    fn a_single_precision_field_counts_as_the_exact_one() {
+        let (pos, tris) = sphere();
+        let centres: Vec<Point3> = pos.iter().step_by(7).copied().collect();
+        let values: Vec<Point3> = centres
+            .iter()
+            .map(|p| [0.3 * p[1] * p[2], 0.2 * (3.0 * p[0]).sin(), -0.25 * p[0] * p[1]])
+            .collect();
+        let f = Arc::new(Rbf::fit(&centres, &values, crate::fit::rbf::Kernel::Linear, "test").unwrap());
+        let progress = Progress::new();
+        let (mut exact, mut approx) = (Orientation::new(&pos, &tris), Orientation::new(&pos, &tris));
+        exact.push(&pos, |_, p| field_step(&f.gradient(p), 0.5));
+        approx.push_field(&pos, f.clone(), 0.5, &progress).unwrap();
+        // Midpoints of some edges, added between the two maps, then more after the last.
+        let mut parents: Vec<[(u32, f64); 3]> =
+            tris.iter().take(40).map(|t| [(t[0], 0.5), (t[1], 0.5), (t[2], 0.0)]).collect();
+        exact.sync(&parents);
+        approx.sync(&parents);
+        let mut at = pos.clone();
+        for p in &parents {
+            at.push(scale(add(at[p[0].0 as usize], at[p[1].0 as usize]), 0.5));
+        }
+        exact.push(&at, |_, p| field_step(&f.gradient(p), 1.0));
+        approx.push_field(&at, f.clone(), 1.0, &progress).unwrap();
+        let nv = at.len() as u32;
+        parents.extend((0..10u32).map(|i| [(nv - 1 - i, 0.25), (i, 0.75), (0, 0.0)]));
+        exact.sync(&parents);
+        approx.sync(&parents);
+        let n = exact.len() as u32;
+        // Faces on template vertices, on vertices added between the maps, and after them.
+        let faces: Vec<[u32; 3]> =
+            tris.iter().take(30).copied().chain((0..20).map(|i| [i, nv - 1 - i, n - 1 - i % 10])).collect();
+        let (mut open, mut counted) = (0, 0);
+        for t in &faces {
+            // The exact reference, from the f64 push.
+            let normals = exact.corner_normals(t);
+            let mut r = [0.0; 3];
+            for k in 0..3 {
+                r = add(r, push_normal(&exact.jacobians[t[k] as usize], normals[k]));
+            }
+            let r = normalize(r);
+            let side = normalize(cross(r, [0.3, -0.5, 0.8]));
+            for sign in [-1.0, 1.0] {
+                let mut out = vec![[0.0; 3]; n as usize];
+                let corners = face_with_normal([0.1, 0.2, 0.3], add(side, scale(r, sign * 1e-10)));
+                for k in 0..3 {
+                    out[t[k] as usize] = corners[k];
+                }
+                let truth = (sign < 0.0) as usize;
+                assert_eq!(exact.faces_against(&out, &[*t]), truth, "f64 push, face {t:?}");
+                assert_eq!(approx.faces_against(&out, &[*t]), truth, "f32 push, face {t:?}");
+                let stored = |v: u32| (approx.jacobians[v as usize], approx.errors[v as usize]);
+                open += (approx.decide(&out, t, stored) == Decision::Open) as usize;
+                counted += truth;
+            }
+        }
+        assert_eq!(open, 2 * faces.len(), "every such face is open under the single-precision bounds");
+        assert_eq!(counted, faces.len());
+        // Faces far from perpendicular: decided from the bounds, the same count.
+        assert_eq!(approx.faces_against(&pos, &tris), exact.faces_against(&pos, &tris));
+        assert_eq!(approx.faces_inverted(&tris), exact.faces_inverted(&tris));
     }
 
     /// cof(J)·n is the normal of the image of a face with normal n, and det J its volume factor.

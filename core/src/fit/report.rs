@@ -81,12 +81,21 @@ pub struct Quality {
     pub curve_residual_mean: f64,
     pub chain_deviation_max: f64,
     pub segments_as_edges: f64,
+    /// Output faces turned against the template's normals pushed forward by the fit's maps
+    /// ([`super::orientation`]).
     pub flipped_faces: usize,
+    /// Faces the maps themselves turned inside out (det J ≤ 0 at two or more corners).
+    pub faces_inverted_by_maps: usize,
+    /// Output faces turned against the fine-deformed surface (the measure before session 13).
+    pub flipped_faces_against_fine_surface: usize,
 }
 
 impl Quality {
-    /// `reference_pos`/`reference_normals`: the fine-deformed mesh before re-triangulation; an
-    /// output face counts as flipped when its normal opposes the sum of its corners' reference normals.
+    /// `reference_pos`/`reference_normals`: the fine-deformed mesh before re-triangulation (the
+    /// measure before session 13: a face opposing the sum of its corners' reference normals);
+    /// `orientation`: the template's normals pushed forward by the fit's maps, per output vertex
+    /// (`flipped_faces`, [`super::orientation`]).
+    #[allow(clippy::too_many_arguments)]
     pub fn measure(
         out: &Mesh,
         net: &CurveNetwork,
@@ -95,6 +104,7 @@ impl Quality {
         tris: &[[u32; 3]],
         reference_pos: &[Point3],
         reference_normals: &[Point3],
+        orientation: &super::orientation::Orientation,
     ) -> Quality {
         let pos = &out.positions;
         let res: Vec<f64> =
@@ -136,7 +146,9 @@ impl Quality {
             curve_residual_mean: res.iter().sum::<f64>() / res.len().max(1) as f64,
             chain_deviation_max: dev,
             segments_as_edges: ok as f64 / realised.chains.len().max(1) as f64,
-            flipped_faces: flipped,
+            flipped_faces: orientation.faces_against(pos, tris),
+            faces_inverted_by_maps: orientation.faces_inverted(tris),
+            flipped_faces_against_fine_surface: flipped,
         }
     }
 }

@@ -26,7 +26,10 @@ use super::align::sym_eigen;
 use super::kdtree::KdTree;
 
 mod cpd_solve;
+mod gradient;
 mod system;
+
+pub use gradient::BoundedGradient;
 
 pub use system::{CHOLESKY_CENTRES, CHOLESKY_MIN_SPREAD};
 

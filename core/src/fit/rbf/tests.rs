@@ -212,3 +212,47 @@ fn the_gradient_matches_finite_differences() {
         }
     }
 }
+
+/// The single-precision gradients ([`Rbf::gradients_bounded`]) stay within their error bounds of
+/// the exact ones: far from the centres, 1e-7 from one and on one (where the exact gradient leaves
+/// that centre out). Away from the centres the bounds are small, so the orientation count decides
+/// nearly every face from them. The cubic kernel is exact (bound 0).
+#[test]
+fn single_precision_gradients_stay_within_their_bounds() {
+    let c: Vec<Point3> = (0..400)
+        .map(|i| {
+            let (a, b) = (i as f64 * 0.61, i as f64 * 0.237);
+            [a.cos() * b.sin() * (1.0 + 0.1 * (3.0 * a).sin()), a.sin() * b.sin(), b.cos() + 0.05 * a.cos()]
+        })
+        .collect();
+    let vals: Vec<Point3> =
+        c.iter().map(|p| [0.3 * p[1] * p[2], 0.2 * (3.0 * p[0]).sin(), -0.25 * p[0] * p[1] + 0.1]).collect();
+    let mut points: Vec<Point3> = (0..50)
+        .map(|i| [(i as f64 * 0.77).sin() * 1.3, (i as f64 * 0.31).cos(), (i % 9) as f64 * 0.2 - 0.8])
+        .collect();
+    let far = points.len();
+    points.push(c[5]);
+    points.push([c[17][0] + 1e-7, c[17][1], c[17][2]]);
+    for kernel in [Kernel::Linear, Kernel::Cubic] {
+        let f = Rbf::fit(&c, &vals, kernel, "test").unwrap();
+        let got = f.gradients_bounded(&points, &Progress::new()).unwrap();
+        for (i, (p, (g, bound))) in points.iter().zip(&got).enumerate() {
+            let exact = f.gradient(*p);
+            let (mut err, mut size) = (0.0f64, 0.0f64);
+            for r in 0..3 {
+                for k in 0..3 {
+                    err += (g[r][k] - exact[r][k]).powi(2);
+                    size += exact[r][k].powi(2);
+                }
+            }
+            let (err, size) = (err.sqrt(), size.sqrt());
+            assert!(err <= *bound, "{kernel:?} point {i}: error {err:e} over the bound {bound:e}");
+            if kernel == Kernel::Cubic {
+                assert_eq!(*bound, 0.0);
+            } else if i <= far {
+                // Far points, and the point on a centre (that term is left out exactly).
+                assert!(*bound < 1e-3 * (1.0 + size), "point {i}: bound {bound:e}, gradient {size}");
+            }
+        }
+    }
+}
