@@ -198,7 +198,10 @@ pub fn thin_network(curves: &Mesh, k: usize) -> Mesh {
 
 /// Pairs as a user would pick them on a section network: at up to `count` crossing points
 /// (curve vertices used by ≥ 4 two-point lines, i.e. where sections meet), the template vertex
-/// nearest to the crossing on the *undeformed* surface ↔ the crossing moved by `map`.
+/// nearest to the crossing on the *undeformed* surface ↔ the crossing moved by `map`. The vertex is
+/// taken on the piece of the template under the crossing (the piece of its closest face): a user
+/// clicks the surface the crossing lies on, not a vertex of another piece that happens to be nearer
+/// (suzanne's eyes under crossings on its head; the nearest vertex overall sent them there).
 pub fn crossing_pairs(
     curves: &Mesh,
     template: &Mesh,
@@ -214,17 +217,55 @@ pub fn crossing_pairs(
     let mut crossings: Vec<u32> = degree.iter().filter(|(_, &d)| d >= 4).map(|(&v, _)| v).collect();
     crossings.sort();
     let step = (crossings.len() / count.max(1)).max(1);
-    let tree = crate::fit::kdtree::KdTree::new(&template.positions);
+    let tris = fan_triangles(&template.faces);
+    let piece = vertex_pieces(template.positions.len(), &tris);
     crossings
         .iter()
         .step_by(step)
         .take(count)
         .filter_map(|&c| {
             let p = curves.positions[c as usize];
-            let (v, _) = tree.nearest(p)?;
-            Some(crate::fit::FitPair { template_vertex: v, curve_point: map(p) })
+            let on = closest_face(&template.positions, &tris, p).map(|t| piece[tris[t][0] as usize]);
+            let v = (0..template.positions.len())
+                .filter(|&v| on.is_none_or(|k| piece[v] == k))
+                .min_by(|&a, &b| d2(template.positions[a], p).total_cmp(&d2(template.positions[b], p)))?;
+            Some(crate::fit::FitPair { template_vertex: v as u32, curve_point: map(p) })
         })
         .collect()
+}
+
+fn d2(a: Point3, b: Point3) -> f64 {
+    let d = sub(a, b);
+    dot(d, d)
+}
+
+/// The index of the triangle closest to `p` (brute force: a handful of queries per network).
+fn closest_face(pos: &[Point3], tris: &[[u32; 3]], p: Point3) -> Option<usize> {
+    let dist = |t: &[u32; 3]| {
+        let q = crate::spatial::closest_on_triangle(p, &t.map(|v| pos[v as usize]));
+        d2(p, q)
+    };
+    (0..tris.len()).min_by(|&a, &b| dist(&tris[a]).total_cmp(&dist(&tris[b])))
+}
+
+/// Each vertex's piece (connected through faces), by union–find; unreferenced vertices are pieces
+/// of their own.
+fn vertex_pieces(n: usize, tris: &[[u32; 3]]) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    for t in tris {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
+            parent[a.max(b)] = a.min(b);
+        }
+    }
+    (0..n).map(|v| root(&mut parent, v)).collect()
 }
 
 /// Regions a set of planes cuts a surface into (the truth for section networks), counted on a
@@ -353,4 +394,52 @@ pub fn sections_of_repaired(raw: Mesh) -> crate::error::Result<(Mesh, Mesh, usiz
     let planes = sweep_planes(&fixed);
     let expected = section_regions(&fixed, &planes);
     Ok((plane_sections(&fixed, &planes), raw_unit, expected))
+}
+
+#[cfg(test)]
+mod crossing_pair_tests {
+    use super::*;
+    use crate::shapes::icosphere;
+
+    /// A coarse unit icosahedron and, just under the middle of one of its faces, a small fine
+    /// sphere (a second piece). The crossing sits at that face's centre, far from the face's own
+    /// corners but 0.02 from the small sphere: its pair must take a corner of the face it lies on.
+    #[test]
+    fn a_crossing_is_paired_with_a_vertex_of_the_piece_it_lies_on() {
+        let mut t = icosphere(0, 1.0);
+        let f: Vec<u32> = t.faces.get(0).to_vec();
+        let k: [Point3; 3] = [0, 1, 2].map(|i| t.positions[f[i] as usize]);
+        let c = scale(add(add(k[0], k[1]), k[2]), 1.0 / 3.0);
+        let n = scale(c, 1.0 / dot(c, c).sqrt());
+        let small = icosphere(3, 0.05);
+        let base = t.positions.len() as u32;
+        // The small sphere's top is 0.02 under the crossing, on the inside.
+        let centre = sub(c, scale(n, 0.07));
+        t.positions.extend(small.positions.iter().map(|&p| add(centre, p)));
+        for i in 0..small.faces.len() {
+            let g: Vec<u32> = small.faces.get(i).iter().map(|&v| v + base).collect();
+            t.faces.push(&g, 0);
+        }
+        let (u, w) = (sub(k[1], k[0]), sub(k[2], k[0]));
+        let curves = Mesh {
+            positions: vec![
+                c,
+                add(c, scale(u, 0.1)),
+                sub(c, scale(u, 0.1)),
+                add(c, scale(w, 0.1)),
+                sub(c, scale(w, 0.1)),
+            ],
+            curves: vec![vec![0, 1], vec![0, 2], vec![0, 3], vec![0, 4]],
+            ..Default::default()
+        };
+        let pairs = crossing_pairs(&curves, &t, 12, |p| p);
+        assert_eq!(pairs.len(), 1);
+        let v = pairs[0].template_vertex;
+        // The nearest vertex overall is on the small sphere (≤ 0.03 away, the corners ~0.5).
+        let nearest = (0..t.positions.len() as u32)
+            .min_by(|&a, &b| d2(t.positions[a as usize], c).total_cmp(&d2(t.positions[b as usize], c)))
+            .unwrap();
+        assert!(nearest >= base, "the set-up must put another piece nearest");
+        assert!(f.contains(&v), "paired with vertex {v}, not a corner {f:?} of the face under the crossing");
+    }
 }
