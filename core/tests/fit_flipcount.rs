@@ -8,21 +8,16 @@ use meshwork_core::fit::testdata::{
 use meshwork_core::fit::{run, Alignment, FitPair, FitParams};
 use meshwork_core::geometry::{dist, dot, normalize};
 use meshwork_core::mesh::{Mesh, Point3};
-use meshwork_core::shapes::icosphere;
+use meshwork_core::shapes::{icosphere, octahedron};
 use meshwork_core::Progress;
 
 /// The pairs that send the unit sphere's six axis points to `image` of themselves, each through the
 /// template vertex nearest to its preimage.
 fn axis_pairs(template: &Mesh, image: impl Fn(Point3) -> Point3) -> Vec<FitPair> {
-    let axes = [
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    axes.iter()
+    // The octahedron's vertices are the six axis points.
+    octahedron()
+        .positions
+        .iter()
         .map(|&a| {
             let v = (0..template.positions.len())
                 .min_by(|&i, &j| dist(template.positions[i], a).total_cmp(&dist(template.positions[j], a)))

@@ -218,54 +218,31 @@ pub fn crossing_pairs(
     crossings.sort();
     let step = (crossings.len() / count.max(1)).max(1);
     let tris = fan_triangles(&template.faces);
-    let piece = vertex_pieces(template.positions.len(), &tris);
+    let piece = crate::fit::insert::walk::face_components(template.positions.len(), &tris);
+    let mut vertex_piece = vec![None; template.positions.len()];
+    for (t, p) in tris.iter().zip(&piece) {
+        for &v in t {
+            vertex_piece[v as usize] = Some(*p);
+        }
+    }
+    let bvh = crate::spatial::Bvh::new(&template.positions, &crate::mesh::Faces::from_triangles(&tris));
+    let d2 = |v: usize, p: Point3| {
+        let d = sub(template.positions[v], p);
+        dot(d, d)
+    };
     crossings
         .iter()
         .step_by(step)
         .take(count)
         .filter_map(|&c| {
             let p = curves.positions[c as usize];
-            let on = closest_face(&template.positions, &tris, p).map(|t| piece[tris[t][0] as usize]);
+            let on = bvh.closest(p).map(|c| piece[c.face as usize]);
             let v = (0..template.positions.len())
-                .filter(|&v| on.is_none_or(|k| piece[v] == k))
-                .min_by(|&a, &b| d2(template.positions[a], p).total_cmp(&d2(template.positions[b], p)))?;
+                .filter(|&v| on.is_none_or(|k| vertex_piece[v] == Some(k)))
+                .min_by(|&a, &b| d2(a, p).total_cmp(&d2(b, p)))?;
             Some(crate::fit::FitPair { template_vertex: v as u32, curve_point: map(p) })
         })
         .collect()
-}
-
-fn d2(a: Point3, b: Point3) -> f64 {
-    let d = sub(a, b);
-    dot(d, d)
-}
-
-/// The index of the triangle closest to `p` (brute force: a handful of queries per network).
-fn closest_face(pos: &[Point3], tris: &[[u32; 3]], p: Point3) -> Option<usize> {
-    let dist = |t: &[u32; 3]| {
-        let q = crate::spatial::closest_on_triangle(p, &t.map(|v| pos[v as usize]));
-        d2(p, q)
-    };
-    (0..tris.len()).min_by(|&a, &b| dist(&tris[a]).total_cmp(&dist(&tris[b])))
-}
-
-/// Each vertex's piece (connected through faces), by union–find; unreferenced vertices are pieces
-/// of their own.
-fn vertex_pieces(n: usize, tris: &[[u32; 3]]) -> Vec<usize> {
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut v: usize) -> usize {
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
-    for t in tris {
-        for k in 1..3 {
-            let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
-            parent[a.max(b)] = a.min(b);
-        }
-    }
-    (0..n).map(|v| root(&mut parent, v)).collect()
 }
 
 /// Regions a set of planes cuts a surface into (the truth for section networks), counted on a
@@ -436,9 +413,8 @@ mod crossing_pair_tests {
         assert_eq!(pairs.len(), 1);
         let v = pairs[0].template_vertex;
         // The nearest vertex overall is on the small sphere (≤ 0.03 away, the corners ~0.5).
-        let nearest = (0..t.positions.len() as u32)
-            .min_by(|&a, &b| d2(t.positions[a as usize], c).total_cmp(&d2(t.positions[b as usize], c)))
-            .unwrap();
+        let d2 = |v: u32| crate::geometry::dist(t.positions[v as usize], c);
+        let nearest = (0..t.positions.len() as u32).min_by(|&a, &b| d2(a).total_cmp(&d2(b))).unwrap();
         assert!(nearest >= base, "the set-up must put another piece nearest");
         assert!(f.contains(&v), "paired with vertex {v}, not a corner {f:?} of the face under the crossing");
     }
