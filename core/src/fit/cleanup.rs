@@ -12,8 +12,9 @@
 //! - curve edges are never flipped and curve (and boundary) vertices never removed;
 //! - both faces of a flipped edge, and all faces of a removed vertex, carry the same label (the
 //!   caller's region × template group), so regions are never merged and groups never mixed;
-//! - no resulting face is degenerate or turned against the local surface normal (the sum of the
-//!   reference vertex normals at its corners), or against the face it replaces;
+//! - no resulting face is degenerate or turned against its reference ([`Reference::face`]: in
+//!   the fit, the template's normal carried by the fit's maps, the report's `flipped_faces`
+//!   reference), or against the face it replaces;
 //! - the edit strictly raises the worst smallest angle among the faces it changes (so the
 //!   process terminates) and keeps the shape: a flip sweeps a small volume relative to the two
 //!   faces, and a removed vertex lies close to the faces that replace its star;
@@ -28,6 +29,7 @@ use crate::geometry::{add, cross, dot, norm, norm2, sub, triangle_cross};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
+use super::reference::Reference;
 use super::smooth::min_angle_quality;
 use super::trimesh::{IntMap, TriMesh};
 
@@ -90,8 +92,8 @@ pub struct Constraints<'a> {
     /// pulled onto a segment) → their two chain neighbours. Such a vertex may be removed into a
     /// chain neighbour: the three are on one segment, so the chain stays a chain of edges on it.
     pub chain: IntMap<u32, [u32; 2]>,
-    /// Unit vertex normals of the surface before re-triangulation (the local normal).
-    pub reference_normals: &'a [Point3],
+    /// What each face should face (the fit's carried reference).
+    pub reference: &'a dyn Reference,
     /// Per template vertex, the quality (sin² of the smallest angle) of the thinnest template
     /// face at it ([`template_floor`]); vertices past its end (added by the fit) have none.
     pub template_floor: &'a [f64],
@@ -161,11 +163,7 @@ fn tri_normal(mesh: &TriMesh, t: [u32; 3]) -> Point3 {
 /// A face would be acceptable: not degenerate, and facing the way the surface does.
 fn well_oriented(mesh: &TriMesh, c: &Constraints, t: [u32; 3]) -> bool {
     let n = tri_normal(mesh, t);
-    let rn = add(
-        add(c.reference_normals[t[0] as usize], c.reference_normals[t[1] as usize]),
-        c.reference_normals[t[2] as usize],
-    );
-    norm2(n) > 0.0 && dot(n, rn) > 0.0
+    norm2(n) > 0.0 && dot(n, c.reference.face(t)) > 0.0
 }
 
 fn min_angle_deg(q: f64) -> f64 {
@@ -533,12 +531,12 @@ fn collapse(mesh: &mut TriMesh, labels: &mut Vec<u64>, x: u32, y: u32) -> bool {
 mod tests {
     use super::*;
 
-    fn constraints<'a>(fixed: &'a [bool], locked: &EdgeSet, n: &'a [Point3]) -> Constraints<'a> {
+    fn constraints<'a>(fixed: &'a [bool], locked: &EdgeSet, n: &'a Vec<Point3>) -> Constraints<'a> {
         Constraints {
             fixed,
             locked: locked.clone(),
             chain: IntMap::default(),
-            reference_normals: n,
+            reference: n,
             template_floor: &[],
         }
     }

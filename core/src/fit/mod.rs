@@ -36,6 +36,7 @@ pub mod orientation;
 mod params;
 pub mod partition;
 pub mod rbf;
+pub mod reference;
 pub mod refine;
 pub mod report;
 pub mod retriangulate;
@@ -281,7 +282,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         // vertices may get a free vertex on one of their edges.
         untangle::untangle_with_splits(
             &mut mesh,
-            &reference_normals,
+            &mut reference_normals,
             &realised.on_curve,
             &curve_edges,
             8,
@@ -289,11 +290,10 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         )
     })?;
     mesh.check_growth("untangle_retriangulated")?;
-    // Vertices those splits added: after the re-triangulation's in every per-vertex array.
+    // Vertices those splits added: after the re-triangulation's in every per-vertex array (the
+    // reference normals have them already, the normalised sum of their edge's ends).
     for a in &untangle_retri.added {
         parents.push(*a);
-        let n = add(reference_normals[a[0].0 as usize], reference_normals[a[1].0 as usize]);
-        reference_normals.push(crate::geometry::normalize(n));
         realised.on_curve.push(false);
     }
     let retri_tris = mesh.live_triangles();
@@ -332,7 +332,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             fixed: &fixed,
             locked: curve_edges.clone(),
             chain: cleanup::Constraints::chain_vertices(&realised.chains, &curve_point, &boundary),
-            reference_normals: &reference_normals,
+            reference: &reference_normals,
             template_floor: &template_floor,
         };
         let s = cleanup::CleanupSettings { min_angle_deg: params.cleanup_min_angle_deg, max_passes: 8 };

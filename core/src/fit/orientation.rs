@@ -38,6 +38,7 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::rbf::Rbf;
+use super::reference::{Reference, SplitReference};
 
 /// A 3×3 Jacobian: `j[r][c]` = ∂(output r)/∂(input c).
 pub type Jacobian = [[f64; 3]; 3];
@@ -92,6 +93,8 @@ pub struct Orientation {
     /// The template's unit face normals and area-weighted vertex normals.
     face_normals: Vec<Point3>,
     vertex_normals: Vec<Point3>,
+    /// The template's triangles (for "is template vertex v a corner of template face f").
+    template_tris: Vec<[u32; 3]>,
     /// Template faces around each template vertex (CSR).
     vf_start: Vec<u32>,
     vf: Vec<u32>,
@@ -100,6 +103,13 @@ pub struct Orientation {
     replay: Option<Replay>,
     /// Each vertex's index when the maps were pushed (identity until [`Orientation::renumbered`]).
     working: Option<Vec<u32>>,
+    /// The repair reference of the working mesh's face ids, and cof(J) per vertex
+    /// ([`Orientation::cache_faces`]); cleared by every map pushed.
+    face_cache: Vec<Point3>,
+    cofactors: Vec<Jacobian>,
+    /// Per vertex: the last map pushed (the fine RBF, in the fit) turns space inside out there
+    /// ([`Side::LastMap`]).
+    last_inverted: Vec<bool>,
 }
 
 /// `cof(J)·n` and `det J`: with the columns a, b, c of J, cof(J) = [b×c, c×a, a×b].
@@ -115,6 +125,19 @@ pub fn cofactor_times(j: &Jacobian, n: Point3) -> (Point3, f64) {
 pub fn push_normal(j: &Jacobian, n: Point3) -> Point3 {
     let (c, det) = cofactor_times(j, n);
     normalize(if det > 0.0 { c } else { scale(c, -1.0) })
+}
+
+/// cof(J) as a matrix: cof(J)·n = [b×c, c×a, a×b]·n for the columns a, b, c of J, as
+/// [`cofactor_times`] computes it.
+fn cofactor(j: &Jacobian) -> Jacobian {
+    let col = |k: usize| [j[0][k], j[1][k], j[2][k]];
+    let (a, b, c) = (col(0), col(1), col(2));
+    let (bc, ca, ab) = (cross(b, c), cross(c, a), cross(a, b));
+    std::array::from_fn(|r| [bc[r], ca[r], ab[r]])
+}
+
+fn mat_vec(m: &Jacobian, n: Point3) -> Point3 {
+    [dot(m[0], n), dot(m[1], n), dot(m[2], n)]
 }
 
 /// `a · b` for 3×3 matrices.
@@ -140,9 +163,9 @@ fn field_step(g: &Jacobian, step: f64) -> Jacobian {
 /// open). Bounds for ‖ΔJ‖_F ≤ e: cof(J)·n = (J·a)×(J·b) for orthonormal a, b with a×b = n, so it
 /// moves by at most 2(‖J‖ + e)e; det J, a triple product of columns, by at most 3(‖J‖ + e)²e;
 /// and a unit vector c/|c| by at most 2|Δc|/|c|.
-fn corner(j: &Jacobian, e: f64, n: Point3) -> (Point3, f64) {
+fn corner(j: &Jacobian, e: f64, n: Point3, side: Side) -> (Point3, f64) {
     let (c, d) = cofactor_times(j, n);
-    let unit = normalize(if d > 0.0 { c } else { scale(c, -1.0) });
+    let unit = normalize(if d > 0.0 || side == Side::Image { c } else { scale(c, -1.0) });
     if e == 0.0 || dot(n, n) == 0.0 {
         return (unit, 0.0);
     }
@@ -151,6 +174,29 @@ fn corner(j: &Jacobian, e: f64, n: Point3) -> (Point3, f64) {
     let open = !(d.abs() > dd && len > 2.0 * dc);
     (unit, if open { 2.0 } else { 2.0 * dc / len })
 }
+
+/// Which way a corner's pushed-forward template normal points where the maps invert space.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// J⁻ᵀ·n: against the image of the template face where det J ≤ 0 (the count: a face the maps
+    /// turned inside out is turned over relative to the template).
+    Covector,
+    /// cof(J)·n: the normal of the template face's image under the maps, whatever det J (the
+    /// repair stages: where the maps turned space inside out no local edit can undo it, so the
+    /// repair keeps faces consistent with the maps' image there, as the fine-surface normals it
+    /// used before did; those faces stay counted, also in `faces_inverted_by_maps`).
+    Image,
+    /// cof(J)·n, turned where the last map pushed inverts space: the untangling right after the
+    /// fine stage undoes the fine map's own (local) inversions, as it did against the surface
+    /// before that map until session 15, and follows the earlier maps' image.
+    LastMap,
+}
+
+/// The side the repair stages take ([`Reference for Orientation`]). The count's side instead
+/// (measured, session 15): the cross-template rows of `sweep_unseen` went from 353 to 1,549
+/// (rocker-arm on homer's sections) and from 170 to 1,078 (icosphere on homer's) flipped faces,
+/// the untanglings chasing every face of the regions the maps turned inside out.
+const REPAIR_SIDE: Side = Side::Image;
 
 /// A face's orientation against its reference: decided either way, or left open by the bounds.
 #[derive(Clone, Copy, PartialEq)]
@@ -196,11 +242,15 @@ impl Orientation {
                 })
                 .collect(),
             vertex_normals: super::report::vertex_normals(template_pos, template_tris),
+            template_tris: template_tris.to_vec(),
             vf_start,
             vf,
             base: nv,
             replay: None,
             working: None,
+            face_cache: Vec::new(),
+            cofactors: Vec::new(),
+            last_inverted: vec![false; nv],
         }
     }
 
@@ -217,7 +267,7 @@ impl Orientation {
     /// Whether template face `f` is at place `p`.
     fn touches(&self, p: Place, f: u32) -> bool {
         match p {
-            Place::Vertex(_) => self.faces_of(p).contains(&f),
+            Place::Vertex(v) => self.template_tris[f as usize].contains(&v),
             Place::Face(g) => g == f,
             Place::Edge(g, h) => g == f || h == f,
             Place::Across => false,
@@ -268,7 +318,16 @@ impl Orientation {
     /// older vertices of vertex `base + i`. A rolled-back addition (a smaller `parents`) is
     /// dropped again.
     pub fn sync(&mut self, parents: &[[(u32, f64); 3]]) {
-        let want = self.base + parents.len();
+        self.truncate_to(self.base + parents.len());
+        for p in &parents[self.jacobians.len() - self.base..] {
+            self.push_vertex(p);
+        }
+    }
+
+    /// Forgets the vertices from `want` on.
+    fn truncate_to(&mut self, want: usize) {
+        self.cofactors.truncate(want);
+        self.last_inverted.truncate(want);
         if want < self.jacobians.len() {
             self.jacobians.truncate(want);
             self.errors.truncate(want);
@@ -280,39 +339,69 @@ impl Orientation {
                 }
             }
         }
-        for p in &parents[self.jacobians.len() - self.base..] {
-            let used = || p.iter().filter(|x| x.1 > 0.0);
-            // The composite map is smooth: its Jacobian between two vertices is their blend (and
-            // the blend's error at most the blend of the errors, the weights being positive).
-            let mut j = [[0.0; 3]; 3];
-            let mut e = 0.0;
-            for &(v, w) in used() {
-                let jv = &self.jacobians[v as usize];
-                for r in 0..3 {
-                    for c in 0..3 {
-                        j[r][c] += w * jv[r][c];
-                    }
+    }
+
+    /// One vertex added as the weighted blend `p` of older ones.
+    fn push_vertex(&mut self, p: &[(u32, f64); 3]) {
+        let used = || p.iter().filter(|x| x.1 > 0.0);
+        // The composite map is smooth: its Jacobian between two vertices is their blend (and
+        // the blend's error at most the blend of the errors, the weights being positive).
+        let mut j = [[0.0; 3]; 3];
+        let mut e = 0.0;
+        for &(v, w) in used() {
+            let jv = &self.jacobians[v as usize];
+            for r in 0..3 {
+                for c in 0..3 {
+                    j[r][c] += w * jv[r][c];
                 }
-                e += w * self.errors[v as usize];
             }
-            let first = used().next().map(|x| self.places[x.0 as usize]);
-            let place = if used().all(|x| Some(self.places[x.0 as usize]) == first) {
-                first.unwrap_or(Place::Across)
-            } else {
-                match self.common_faces(used().map(|x| self.places[x.0 as usize])).as_deref() {
-                    Some([f]) => Place::Face(*f),
-                    Some([f, g]) => Place::Edge(*f, *g),
-                    Some([f, ..]) => Place::Face(*f),
-                    _ => Place::Across,
-                }
-            };
-            self.jacobians.push(j);
-            self.errors.push(e);
-            self.places.push(place);
-            if let Some(r) = self.replay.as_mut() {
-                r.added.push((*p, r.steps.len()));
-            }
+            e += w * self.errors[v as usize];
         }
+        let first = used().next().map(|x| self.places[x.0 as usize]);
+        let place = if used().all(|x| Some(self.places[x.0 as usize]) == first) {
+            first.unwrap_or(Place::Across)
+        } else {
+            match self.common_faces(used().map(|x| self.places[x.0 as usize])).as_deref() {
+                Some([f]) => Place::Face(*f),
+                Some([f, g]) => Place::Edge(*f, *g),
+                Some([f, ..]) => Place::Face(*f),
+                _ => Place::Across,
+            }
+        };
+        // The last map's inversion at the blend: the parents' weighted vote.
+        let vote: f64 = used().map(|&(v, w)| if self.last_inverted[v as usize] { -w } else { w }).sum();
+        self.last_inverted.push(vote < 0.0);
+        self.jacobians.push(j);
+        self.errors.push(e);
+        self.places.push(place);
+        if let Some(r) = self.replay.as_mut() {
+            r.added.push((*p, r.steps.len()));
+        }
+    }
+
+    /// Caches the repair reference ([`Reference::face`]) of the face ids of `tris` past the
+    /// cached ones, in parallel, polling between chunks. Why: the repair stages' scans ask for
+    /// every face many times (the untanglings' reference cost ~80 ms of CPU each on the headline
+    /// uncached), and a face id's corners never change (`TriMesh` never reuses an id), nor do
+    /// the Jacobians of existing vertices. For the fit's one working mesh, from the fine stage
+    /// on; only ever called between stages (an untangling that rolls back splits reuses ids past
+    /// its start, which are never cached).
+    pub fn cache_faces(&mut self, tris: &[[u32; 3]], progress: &Progress) -> Result<()> {
+        const CHUNK: usize = 16384;
+        // cof(J) of every vertex first (faces not cached, e.g. the clean-up's candidates, use it).
+        progress.check()?;
+        let from = self.cofactors.len().min(self.jacobians.len());
+        let more: Vec<Jacobian> = self.jacobians[from..].par_iter().map(cofactor).collect();
+        self.cofactors.extend(more);
+        while self.face_cache.len() < tris.len() {
+            progress.check()?;
+            let from = self.face_cache.len();
+            let to = (from + CHUNK).min(tris.len());
+            let this = &*self;
+            let chunk: Vec<Point3> = tris[from..to].par_iter().map(|&t| this.face(t)).collect();
+            self.face_cache.extend(chunk);
+        }
+        Ok(())
     }
 
     pub fn len(&self) -> usize {
@@ -370,17 +459,22 @@ impl Orientation {
     /// Multiplies every vertex's Jacobian by its step on the left; `bound(v)`: the step's error
     /// bound (‖ΔĴ'‖ ≤ b‖Ĵ‖ + (‖Ŝ‖ + b)·e for Ĵ' = Ŝ·Ĵ). Returns the steps with det ≤ 0.
     fn apply(&mut self, steps: &[Jacobian], bound: impl Fn(usize) -> f64 + Sync) -> usize {
+        self.face_cache.clear();
+        self.cofactors.clear();
+        self.last_inverted.resize(self.jacobians.len(), false);
         self.jacobians
             .par_iter_mut()
             .zip(self.errors.par_iter_mut())
+            .zip(self.last_inverted.par_iter_mut())
             .zip(steps.par_iter())
             .enumerate()
-            .map(|(v, ((j, e), s))| {
+            .map(|(v, (((j, e), last), s))| {
                 let b = bound(v);
                 *e = b * frobenius(j) + (frobenius(s) + b) * *e;
                 *j = mat_mul(s, j);
                 let d = det(s);
-                (d <= 0.0 || !d.is_finite()) as usize
+                *last = d <= 0.0 || !d.is_finite();
+                *last as usize
             })
             .sum()
     }
@@ -408,8 +502,41 @@ impl Orientation {
         }
     }
 
-    /// A face against its reference, the sum over its corners of the template's normal pushed
-    /// forward, with each corner's Jacobian and error bound from `jac`: open when the bounds
+    /// Face `t`'s carried reference: the sum over its corners of the template's normal there
+    /// ([`Orientation::corner_normals`]) pushed forward by the corner's Jacobian, each a unit
+    /// vector, with each corner's Jacobian and error bound from `jac`; and how far those bounds
+    /// could move it. The one definition of a face's reference: the count
+    /// ([`Orientation::decide`]) and the repair stages ([`Reference::face`]) both use it.
+    fn reference_with(
+        &self,
+        t: &[u32; 3],
+        side: Side,
+        jac: impl Fn(u32) -> (Jacobian, f64),
+    ) -> (Point3, f64) {
+        let normals = self.corner_normals(t);
+        let (mut r, mut slack) = ([0.0; 3], 0.0);
+        for (k, &v) in t.iter().enumerate() {
+            let turned = side == Side::LastMap && self.last_inverted.get(v as usize) == Some(&true);
+            let side = if side == Side::LastMap { Side::Image } else { side };
+            // The repair sides (stored Jacobians, no bound): from cof(J) kept, the same vector as
+            // `corner` gives. Never the count, which needs `jac`'s exact Jacobians and bounds.
+            if side == Side::Image {
+                if let Some(c) = self.cofactors.get(v as usize) {
+                    let c = mat_vec(c, normals[k]);
+                    r = add(r, normalize(if turned { scale(c, -1.0) } else { c }));
+                    continue;
+                }
+            }
+            let (j, e) = jac(v);
+            let (unit, moves) = corner(&j, e, normals[k], side);
+            let unit = if turned { scale(unit, -1.0) } else { unit };
+            r = add(r, unit);
+            slack += moves;
+        }
+        (r, slack)
+    }
+
+    /// A face against its reference ([`Orientation::reference_with`]): open when the bounds
     /// could change the sign.
     fn decide(&self, pos: &[Point3], t: &[u32; 3], jac: impl Fn(u32) -> (Jacobian, f64)) -> Decision {
         let n = normalize(triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]));
@@ -417,14 +544,7 @@ impl Orientation {
             // A zero-area face has no normal to oppose anything (counted elsewhere: `degenerate`).
             return Decision::With;
         }
-        let normals = self.corner_normals(t);
-        let (mut r, mut slack) = ([0.0; 3], 0.0);
-        for (k, &v) in t.iter().enumerate() {
-            let (j, e) = jac(v);
-            let (unit, moves) = corner(&j, e, normals[k]);
-            r = add(r, unit);
-            slack += moves;
-        }
+        let (r, slack) = self.reference_with(t, Side::Covector, jac);
         let d = dot(n, r);
         if slack > 0.0 && d.abs() <= slack {
             Decision::Open
@@ -507,6 +627,9 @@ impl Orientation {
         self.jacobians = keep.vec(&self.jacobians);
         self.errors = keep.vec(&self.errors);
         self.places = keep.vec(&self.places);
+        self.last_inverted = keep.vec(&self.last_inverted);
+        self.face_cache.clear();
+        self.cofactors = keep.vec(&self.cofactors);
         self
     }
 }
@@ -550,6 +673,60 @@ fn replay_jacobian(
     }
     memo.insert((v, upto), j);
     Some(j)
+}
+
+/// The repair stages' reference ([`super::reference`]): the count's function with the stored
+/// Jacobians, without the error bounds (the count decides again exactly only the faces the bounds
+/// leave open: 5 of 193,548 on the headline), on the maps' image side ([`Side::Image`]: the same
+/// as the count's wherever no corner of a face was inverted by the maps). Valid for the working
+/// numbering, before [`Orientation::renumbered`].
+impl Reference for Orientation {
+    fn face(&self, t: [u32; 3]) -> Point3 {
+        self.reference_with(&t, REPAIR_SIDE, |v| (self.jacobians[v as usize], 0.0)).0
+    }
+
+    fn face_of(&self, mesh: &super::trimesh::TriMesh, f: u32) -> Point3 {
+        match self.face_cache.get(f as usize) {
+            Some(&r) => r,
+            None => self.face(mesh.tris[f as usize]),
+        }
+    }
+}
+
+/// The repair reference of the untangling right after the fine stage ([`Side::LastMap`]).
+pub struct AfterLastMap<'a>(pub &'a Orientation);
+
+impl Reference for AfterLastMap<'_> {
+    fn face(&self, t: [u32; 3]) -> Point3 {
+        let o = self.0;
+        o.reference_with(&t, Side::LastMap, |v| (o.jacobians[v as usize], 0.0)).0
+    }
+
+    fn face_of(&self, mesh: &super::trimesh::TriMesh, f: u32) -> Point3 {
+        let t = mesh.tris[f as usize];
+        if REPAIR_SIDE == Side::Image && !t.iter().any(|&v| self.0.last_inverted[v as usize]) {
+            // The same as the cached repair reference where the last map inverts no corner.
+            self.0.face_of(mesh, f)
+        } else {
+            self.face(t)
+        }
+    }
+}
+
+/// Vertices the untangling adds on split edges take the blend of the edge's ends, as
+/// [`Orientation::sync`] gives them from the parents the fit records for them.
+impl SplitReference for Orientation {
+    fn vertex_count(&self) -> usize {
+        self.jacobians.len()
+    }
+
+    fn push_midpoint(&mut self, a: u32, b: u32) {
+        self.push_vertex(&[(a, 0.5), (b, 0.5), (a, 0.0)]);
+    }
+
+    fn truncate_vertices(&mut self, n: usize) {
+        self.truncate_to(n);
+    }
 }
 
 #[cfg(test)]

@@ -28,6 +28,8 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 use crate::topology::Csr;
 
+use super::reference::Reference;
+
 pub struct SmoothSettings {
     pub mcf_iterations: u32,
     pub mcf_step: f64,
@@ -275,15 +277,14 @@ fn cotangent_sum(
     a
 }
 
-/// Is the face at `pos` turned against the sum of its corners' `reference` normals (negative),
-/// degenerate (zero) or right (positive)? The report's `flipped_faces` test.
-fn orientation(pos: &[Point3], t: [u32; 3], reference: &[Point3]) -> f64 {
-    let r = t.iter().fold([0.0; 3], |acc, &v| add(acc, reference[v as usize]));
+/// Is the face at `pos` turned against its reference `r` (negative), degenerate (zero) or right
+/// (positive)? The report's `flipped_faces` test.
+fn orientation(pos: &[Point3], t: [u32; 3], r: Point3) -> f64 {
     dot(face_normal(pos, t), r)
 }
 
 /// Puts back to `before` (the positions before smoothing) every moved corner of a face that the
-/// smoothing turned against the `reference` vertex normals (or made degenerate) while it was
+/// smoothing turned against its `reference` (or made degenerate) while it was
 /// right before, and repeats on the faces that changes, until no face is worse than before (a face
 /// thinner than the thinnest before smoothing counts as worse: a corner put back next to
 /// neighbours that stay smoothed must not make one). Returns how many vertices were put back.
@@ -297,21 +298,23 @@ pub fn undo_new_flips(
     pos: &mut [Point3],
     before: &[Point3],
     tris: &[[u32; 3]],
-    reference: &[Point3],
+    reference: &impl Reference,
 ) -> usize {
     // A corner put back next to neighbours that stay smoothed could make a face thinner than any
     // before smoothing: such a face counts as worse too, so the smallest angle never drops.
     let quality =
         |p: &[Point3], t: [u32; 3]| min_angle_quality(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
     let floor = tris.iter().map(|&t| quality(before, t)).fold(f64::INFINITY, f64::min);
+    // Each face's reference once (the rounds test every face again).
+    let refs: Vec<Point3> = tris.par_iter().with_min_len(4096).map(|&t| reference.face(t)).collect();
     let mut undone = 0;
     loop {
         let mut changed = 0;
-        for &t in tris {
+        for (&t, &r) in tris.iter().zip(&refs) {
             if t.iter().all(|&v| pos[v as usize] == before[v as usize]) {
                 continue;
             }
-            let (now, was) = (orientation(pos, t, reference), orientation(before, t, reference));
+            let (now, was) = (orientation(pos, t, r), orientation(before, t, r));
             let turned = (now < 0.0 && was >= 0.0) || (now == 0.0 && was > 0.0);
             let worse = turned || {
                 let q = quality(pos, t);
@@ -541,7 +544,7 @@ mod tests {
         let mut pos = before.clone();
         pos[4] = [1.5, 0.0, 0.0];
         pos[5] = [2.8, 0.0, 0.0];
-        assert!(orientation(&pos, tris[1], &reference) < 0.0);
+        assert!(orientation(&pos, tris[1], reference.face(tris[1])) < 0.0);
         assert_eq!(undo_new_flips(&mut pos, &before, &tris, &reference), 1);
         assert_eq!(pos[4], before[4]);
         assert_eq!(pos[5], [2.8, 0.0, 0.0]);
@@ -575,7 +578,10 @@ mod tests {
         let mut pos = before.clone();
         pos[1] = [1.0, -0.5, 0.0];
         pos[3] = [1.5, 0.0, 0.0];
-        assert!(orientation(&pos, tris[0], &reference) > 0.0 && orientation(&pos, tris[1], &reference) < 0.0);
+        assert!(
+            orientation(&pos, tris[0], reference.face(tris[0])) > 0.0
+                && orientation(&pos, tris[1], reference.face(tris[1])) < 0.0
+        );
         assert_eq!(undo_new_flips(&mut pos, &before, &tris, &reference), 2);
         assert_eq!(pos, before);
     }

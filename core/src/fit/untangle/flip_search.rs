@@ -101,7 +101,7 @@ fn neighbourhood(mesh: &TriMesh, ctx: &Ctx, f: u32) -> Vec<u32> {
     while grown < faces.len() && faces.len() < MAX_PATCH_FACES {
         let g = faces[grown];
         grown += 1;
-        if g != f && !ctx.folded(mesh, mesh.tris[g as usize]) {
+        if g != f && !ctx.folded(mesh, g) {
             continue;
         }
         for &v in &mesh.tris[g as usize] {
@@ -246,7 +246,7 @@ pub(super) fn flip_sequences(
     let mut searched: HashSet<u32> = HashSet::new();
     for (i, &f) in bad.iter().enumerate() {
         progress.check_every(i, super::POLL_FOLDED)?;
-        if searched.contains(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
+        if searched.contains(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, f) {
             continue;
         }
         match repair_one(mesh, ctx, f) {

@@ -1,7 +1,8 @@
 //! Untangling folded faces: a face is *folded* when its normal opposes (or is perpendicular to,
-//! within [`MIN_COS`]) the reference normal of its corners (vertex normals of an earlier, unfolded state of the same mesh). Used twice: after the
-//! fine deformation (reference: the surface before it; curve vertices fixed) and after the
-//! re-triangulation (reference: the fine surface; chain vertices fixed, curve edges locked).
+//! within [`MIN_COS`]) its reference ([`Reference::face`]: in the fit, the template's normal
+//! carried by the fit's maps, the report's `flipped_faces` reference; in the unit tests, vertex
+//! normals). Used three times: after the fine deformation (curve vertices fixed), after the
+//! re-triangulation (chain vertices fixed, curve edges locked) and after smoothing.
 //!
 //! Fixes are local and only accepted when they leave no folded face among the faces they touch
 //! and strictly reduce the folded count there:
@@ -19,6 +20,7 @@ use crate::geometry::{add, dot, scale, sub, triangle_cross};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
+use super::reference::{Reference, SplitReference};
 use super::trimesh::TriMesh;
 use super::uvs::{self, UvMove};
 
@@ -64,20 +66,23 @@ pub struct UntangleStats {
 }
 
 pub(crate) struct Ctx<'a> {
-    reference: &'a [Point3],
+    reference: &'a dyn Reference,
     fixed: &'a [bool],
     locked: &'a EdgeSet,
 }
 
 impl Ctx<'_> {
-    fn reference_of(&self, t: [u32; 3]) -> Point3 {
-        add(add(self.reference[t[0] as usize], self.reference[t[1] as usize]), self.reference[t[2] as usize])
-    }
-    /// Cosine between triangle `t`'s normal (corner positions from `p`) and its reference normal;
-    /// 0 for a degenerate triangle or reference.
+    /// Cosine between triangle `t`'s normal (corner positions from `p`) and its reference; 0 for
+    /// a degenerate triangle or reference.
     fn score(&self, t: [u32; 3], p: impl Fn(u32) -> Point3) -> f64 {
+        self.score_against(t, self.reference.face(t), p)
+    }
+    /// [`Ctx::score`] of live face `f` (its reference looked up by id, [`Reference::face_of`]).
+    fn score_face(&self, mesh: &TriMesh, f: u32, p: impl Fn(u32) -> Point3) -> f64 {
+        self.score_against(mesh.tris[f as usize], self.reference.face_of(mesh, f), p)
+    }
+    fn score_against(&self, t: [u32; 3], r: Point3, p: impl Fn(u32) -> Point3) -> f64 {
         let n = triangle_cross(p(t[0]), p(t[1]), p(t[2]));
-        let r = self.reference_of(t);
         let d = (dot(n, n) * dot(r, r)).sqrt();
         if d > 0.0 {
             dot(n, r) / d
@@ -85,31 +90,37 @@ impl Ctx<'_> {
             0.0
         }
     }
-    fn folded(&self, mesh: &TriMesh, t: [u32; 3]) -> bool {
-        self.score(t, |v| mesh.pos[v as usize]) <= MIN_COS
+    /// A unit normal at `v` for per-vertex algorithms ([`Reference::vertex`]).
+    fn normal_at(&self, mesh: &TriMesh, v: u32) -> Point3 {
+        self.reference.vertex(mesh, v)
+    }
+    /// Whether live face `f` is folded.
+    fn folded(&self, mesh: &TriMesh, f: u32) -> bool {
+        self.score_face(mesh, f, |v| mesh.pos[v as usize]) <= MIN_COS
     }
     fn locked(&self, a: u32, b: u32) -> bool {
         self.locked.contains(&(a.min(b), a.max(b)))
     }
 }
 
-/// Faces of `tris` turned against their reference: the normal at `pos` opposes the sum of the
-/// corners' `reference` normals. The same test as the report's `flipped_faces`
-/// ([`super::report::Quality::measure`]), for counting at other points of the pipeline.
-pub fn count_flipped(pos: &[Point3], tris: &[[u32; 3]], reference: &[Point3]) -> usize {
+/// Faces of `tris` turned against their reference: the normal at `pos` opposes
+/// [`Reference::face`]. With vertex normals of the fine surface: the report's measure before
+/// session 13 (`flipped_faces_against_fine_surface`); the carried reference is counted by
+/// [`super::orientation::Orientation::faces_against`].
+pub fn count_flipped(pos: &[Point3], tris: &[[u32; 3]], reference: &impl Reference) -> usize {
     tris.iter()
-        .filter(|t| {
-            let r = t.iter().fold([0.0; 3], |acc, &v| add(acc, reference[v as usize]));
+        .filter(|&&t| {
+            let r = reference.face(t);
             dot(triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]), r) < 0.0
         })
         .count()
 }
 
-/// Untangles `mesh` in place. `reference`: a unit normal per vertex (zero for none); `fixed`:
-/// vertices that must not move (len ≥ mesh vertices); `locked`: undirected edges that must stay.
+/// Untangles `mesh` in place. `reference`: what each face should face; `fixed`: vertices that
+/// must not move (len ≥ mesh vertices); `locked`: undirected edges that must stay.
 pub fn untangle(
     mesh: &mut TriMesh,
-    reference: &[Point3],
+    reference: &impl Reference,
     fixed: &[bool],
     locked: &EdgeSet,
     max_passes: usize,
@@ -131,7 +142,7 @@ const POLL_FOLDED: usize = 64;
 /// [`POLL_FOLDED`] folded faces tried or groups solved.
 pub fn untangle_polled(
     mesh: &mut TriMesh,
-    reference: &[Point3],
+    reference: &impl Reference,
     fixed: &[bool],
     locked: &EdgeSet,
     max_passes: usize,
@@ -181,7 +192,7 @@ fn folded_faces(mesh: &TriMesh, ctx: &Ctx, progress: &Progress) -> Result<Vec<u3
     let mut out = Vec::new();
     for f in 0..mesh.tris.len() {
         progress.check_every(f, POLL_FACES)?;
-        if mesh.alive[f] && ctx.folded(mesh, mesh.tris[f]) {
+        if mesh.alive[f] && ctx.folded(mesh, f as u32) {
             out.push(f as u32);
         }
     }
@@ -199,20 +210,27 @@ const SPLIT_ROUNDS: usize = 3;
 /// corners) is a quadrilateral: every simple quadrilateral has points that see all its sides,
 /// where the four new faces are all turned the right way, and the moves and the patch solver
 /// look for one. Vertices added are reported in `added` (the caller extends its per-vertex
-/// arrays); split vertices are never fixed.
+/// arrays) and given to `reference` ([`SplitReference::push_midpoint`], which must cover
+/// exactly the mesh's vertices on entry); split vertices are never fixed.
 pub fn untangle_with_splits(
     mesh: &mut TriMesh,
-    reference: &[Point3],
+    reference: &mut impl SplitReference,
     fixed: &[bool],
     locked: &EdgeSet,
     max_passes: usize,
     progress: &Progress,
 ) -> Result<UntangleStats> {
+    if reference.vertex_count() != mesh.pos.len() {
+        return Err(crate::error::Error::Internal(format!(
+            "untangle: a reference for {} vertices, the mesh has {}",
+            reference.vertex_count(),
+            mesh.pos.len()
+        )));
+    }
     let mut stats = untangle_polled(mesh, reference, fixed, locked, max_passes, progress)?;
     if stats.folded_after == 0 {
         return Ok(stats);
     }
-    let mut reference = reference[..mesh.pos.len()].to_vec();
     let mut fixed = fixed[..mesh.pos.len()].to_vec();
     for _ in 0..SPLIT_ROUNDS {
         // Each round clones the mesh and untangles it again: on a 100k-vertex template that is
@@ -221,14 +239,14 @@ pub fn untangle_with_splits(
         mesh.check_growth("untangle")?;
         // A round is kept only when it leaves fewer folds (a split whose ring has no place that
         // sees all its edges, e.g. around crossing fixed curve vertices, only adds faces).
-        let snapshot = (mesh.clone(), stats.clone(), reference.len());
+        let snapshot = (mesh.clone(), stats.clone(), reference.vertex_count());
         progress.check()?;
-        let ctx = Ctx { reference: &reference, fixed: &fixed, locked };
+        let ctx = Ctx { reference: &*reference, fixed: &fixed, locked };
         let bad = folded_faces(mesh, &ctx, progress)?;
         let mut batch = Vec::new();
         let mut added = Vec::new();
         for f in bad {
-            if !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
+            if !mesh.alive[f as usize] || !ctx.folded(mesh, f) {
                 continue; // split already by a neighbour's split
             }
             let t = mesh.tris[f as usize];
@@ -248,19 +266,19 @@ pub fn untangle_with_splits(
             break;
         }
         for &(m, a, b) in &added {
-            debug_assert_eq!(m as usize, reference.len());
-            reference.push(crate::geometry::normalize(add(reference[a as usize], reference[b as usize])));
+            debug_assert_eq!(m as usize, reference.vertex_count());
+            reference.push_midpoint(a, b);
             fixed.push(false);
             stats.added.push([(a, 0.5), (b, 0.5), (a, 0.0)]);
         }
         stats.edge_splits += added.len();
         stats.uv_batches.push(batch);
-        let again = untangle_polled(mesh, &reference, &fixed, locked, max_passes, progress)?;
+        let again = untangle_polled(mesh, &*reference, &fixed, locked, max_passes, progress)?;
         if again.folded_after >= stats.folded_after {
             let (m, s, nv) = snapshot;
             *mesh = m;
             stats = s;
-            reference.truncate(nv);
+            reference.truncate_vertices(nv);
             fixed.truncate(nv);
             break;
         }
@@ -295,7 +313,7 @@ fn local_passes(
         let mut changed = false;
         for (i, &f) in bad.iter().enumerate() {
             progress.check_every(i, POLL_FOLDED)?;
-            if !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
+            if !mesh.alive[f as usize] || !ctx.folded(mesh, f) {
                 continue;
             }
             if try_edge_flip(mesh, ctx, f) {
@@ -370,7 +388,7 @@ fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> Option<Option<UvMove>> {
             continue;
         }
         let star: Vec<u32> = mesh.faces_of(v).to_vec();
-        let folded_now = star.iter().filter(|&&g| ctx.folded(mesh, mesh.tris[g as usize])).count();
+        let folded_now = star.iter().filter(|&&g| ctx.folded(mesh, g)).count();
         if folded_now == 0 {
             continue;
         }
@@ -385,7 +403,7 @@ fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> Option<Option<UvMove>> {
         let mean =
             scale(ring.iter().fold([0.0; 3], |a, &w| add(a, mesh.pos[w as usize])), 1.0 / ring.len() as f64);
         let p0 = mesh.pos[v as usize];
-        let n = ctx.reference[v as usize];
+        let n = ctx.normal_at(mesh, v);
         let d = sub(mean, p0);
         let tangential = add(p0, sub(d, scale(n, dot(d, n))));
         // Where a non-convex ring has a place that sees all its edges (the mean does not).
@@ -400,8 +418,7 @@ fn try_moves(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> Option<Option<UvMove>> {
         let kernel = kernel::kernel_centre(&ring_edges, n);
         for target in [Some(tangential), Some(mean), kernel].into_iter().flatten() {
             let ok = star.iter().all(|&g| {
-                let tg = mesh.tris[g as usize];
-                ctx.score(tg, |w| if w == v { target } else { mesh.pos[w as usize] }) > MIN_COS
+                ctx.score_face(mesh, g, |w| if w == v { target } else { mesh.pos[w as usize] }) > MIN_COS
             });
             if ok {
                 let uv = uvs::record(mesh, v, target);
@@ -430,7 +447,7 @@ mod tests {
         let fixed = vec![false; grid.positions.len()];
         let run = |p: &Progress| {
             let mut mesh = TriMesh::new(grid.positions.clone(), tris.clone()).unwrap();
-            untangle_with_splits(&mut mesh, &reference, &fixed, &EdgeSet::default(), 8, p)
+            untangle_with_splits(&mut mesh, &mut reference.clone(), &fixed, &EdgeSet::default(), 8, p)
         };
         let p = Progress::new();
         let st = run(&p).unwrap();

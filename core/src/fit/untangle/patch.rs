@@ -56,7 +56,7 @@ pub(super) fn untangle_patches(
     let mut seen: HashMap<u32, ()> = HashMap::new();
     for (i, &f) in bad.iter().enumerate() {
         progress.check_every(i, super::POLL_FOLDED)?;
-        if seen.contains_key(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, mesh.tris[f as usize]) {
+        if seen.contains_key(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, f) {
             continue;
         }
         let group = folded_group(mesh, ctx, f);
@@ -111,7 +111,7 @@ fn folded_group(mesh: &TriMesh, ctx: &Ctx, f: u32) -> Vec<u32> {
         i += 1;
         for &v in &t {
             for &g in mesh.faces_of(v) {
-                if !mark.contains_key(&g) && ctx.folded(mesh, mesh.tris[g as usize]) {
+                if !mark.contains_key(&g) && ctx.folded(mesh, g) {
                     mark.insert(g, ());
                     group.push(g);
                 }
@@ -183,13 +183,9 @@ fn solve(
         return Err("nothing free");
     }
     // The plane: mean reference normal of the patch.
-    let n = normalize(verts.iter().fold([0.0; 3], |a, &v| add(a, ctx.reference[v as usize])));
-    if n == [0.0; 3]
-        || verts.iter().any(|&v| {
-            let r = ctx.reference[v as usize];
-            r != [0.0; 3] && dot(r, n) < MIN_PLANE_COS
-        })
-    {
+    let normals: Vec<Point3> = verts.iter().map(|&v| ctx.normal_at(mesh, v)).collect();
+    let n = normalize(normals.iter().fold([0.0; 3], |a, &r| add(a, r)));
+    if n == [0.0; 3] || normals.iter().any(|&r| r != [0.0; 3] && dot(r, n) < MIN_PLANE_COS) {
         return Err("too curved");
     }
     let u = normalize(if n[0].abs() < 0.9 { cross(n, [1.0, 0.0, 0.0]) } else { cross(n, [0.0, 1.0, 0.0]) });
@@ -220,10 +216,10 @@ fn solve(
     let lift = |c: [f64; 3]| add(origin, add(add(scale(u, c[0]), scale(w, c[1])), scale(n, c[2])));
     let q_before =
         patch.iter().map(|&f| quality(mesh.tris[f as usize], |v| mesh.pos[v as usize])).fold(1.0, f64::min);
-    let folded_before = patch.iter().filter(|&&f| ctx.folded(mesh, mesh.tris[f as usize])).count();
+    let folded_before = patch.iter().filter(|&&f| ctx.folded(mesh, f)).count();
     let eval = |cand: &[Point3]| {
         let p = |v: u32| cand[index[&v]];
-        let left = patch.iter().filter(|&&f| ctx.score(mesh.tris[f as usize], p) <= MIN_COS).count();
+        let left = patch.iter().filter(|&&f| ctx.score_face(mesh, f, p) <= MIN_COS).count();
         let q = patch.iter().map(|&f| quality(mesh.tris[f as usize], p)).fold(1.0, f64::min);
         (left, q)
     };
