@@ -96,7 +96,7 @@ fn main() {
                         }
                         let ok = r["flipped_faces"] == 0 && r["segments_as_edges"] == 1.0;
                         println!(
-                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {} fine surface {} inverted {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {}",
+                            "{label:<40} {secs:6.2}s {} flips {} (fine {} pre-smooth {} fine surface {} inverted {}) against {against} edges {:.5} regions {}/{want} folded {} dev {dev:.2e} ambiguous {} pieces {} holes {} separated {} realisable {:.5}",
                             if ok { "ok " } else { "BAD" },
                             r["flipped_faces"],
                             r["flipped_faces_after_fine"],
@@ -109,6 +109,8 @@ fn main() {
                             r["alignment"]["ambiguous"],
                             r["retriangulation"]["failed_pieces"],
                             r["retriangulation"]["off_surface_segments"],
+                            r["segments_not_edges"]["separated"],
+                            r["segments_as_edges_realisable"].as_f64().unwrap_or(0.0),
                         );
                     }
                 }

@@ -73,6 +73,12 @@ fn check_holed(template: &Mesh, curves: &Mesh, out: &Output, hole: Option<Point3
     let segs = r["curve_segments"].as_u64().unwrap();
     let edges = r["segments_as_edges"].as_f64().unwrap();
     assert!((edges - (segs - off) as f64 / segs as f64).abs() < 1e-12, "{edges}");
+    // The segments over the hole are the refusals the measure sets apart: every other one is a chain.
+    let not_edges = &r["segments_not_edges"];
+    assert_eq!(not_edges["total"], off, "{not_edges}");
+    assert_eq!(not_edges["off_surface"], off, "{not_edges}");
+    assert_eq!(not_edges["pieces"], 0, "{not_edges}");
+    assert_eq!(r["segments_as_edges_realisable"], 1.0, "{r}");
     // Nothing is routed around the hole.
     assert_eq!(rt["route_long_detours"], 0, "{rt}");
     assert_eq!(r["flipped_faces"], 0);

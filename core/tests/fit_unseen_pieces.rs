@@ -164,4 +164,12 @@ fn segments_between_pieces_no_edge_joins_are_counted_and_named() {
         (share - (segments - 1.0) / segments).abs() < 1e-12,
         "segments_as_edges {share}, {segments} segments"
     );
+    // The measure tells the refusal from a failure: the one segment no chain can realise is the
+    // one not an edge, and every segment a chain can realise is one.
+    let not_edges = &r["segments_not_edges"];
+    assert_eq!(not_edges["total"], 1, "{not_edges}");
+    assert_eq!(not_edges["pieces"], 1, "{not_edges}");
+    assert_eq!(not_edges["separated"], 0, "{not_edges}");
+    assert_eq!(not_edges["broken_after_retriangulation"], 0, "{not_edges}");
+    assert_eq!(r["segments_as_edges_realisable"], 1.0, "{r}");
 }

@@ -181,7 +181,7 @@ fn main() {
                     _ => format!("BAD {}", bad.join("; ")),
                 };
                 format!(
-                    "{status} | regions {} faces {}→{} edges {} flips {} (fine surface {}, inverted {}) resid {:.1e} angle {:.1}/{:.1} net {}",
+                    "{status} | regions {} faces {}→{} edges {} flips {} (fine surface {}, inverted {}) resid {:.1e} angle {:.1}/{:.1} net {} not-edges {}",
                     r["regions"],
                     r["template_triangles"],
                     r["output_faces"],
@@ -196,7 +196,8 @@ fn main() {
                         "welded": r["network"]["welded_points"], "tj": r["network"]["t_junctions"],
                         "ends": r["network"]["ends_merged"], "x": r["network"]["crossings_inserted"],
                         "dangling": r["network"]["dangling_ends"]
-                    })
+                    }),
+                    r["segments_not_edges"]
                 )
             }
         };

@@ -611,6 +611,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();
     report["folds"] = fold_report;
+    report["segments_as_edges_realisable"] = quality.segments_as_edges_realisable.into();
+    report["segments_not_edges"] = serde_json::to_value(quality.segments_not_edges).unwrap_or_default();
     // The guard's measure: the most faces the mesh had after the fine stage, over its base.
     report["face_growth"] = serde_json::json!({
         "peak_faces": mesh.peak_faces(),

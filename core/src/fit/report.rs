@@ -76,11 +76,31 @@ pub fn polyline_chains(net: &CurveNetwork, chains: &[Vec<u32>]) -> Vec<Vec<u32>>
         .collect()
 }
 
+/// The segments that are not edge chains in the output, by why: the two the template's topology
+/// leaves no chain for (`pieces`: ends on two pieces no edge joins; `off_surface`: the straight way
+/// crosses a hole or runs past the rim), the two a chain could exist for (`separated`, `budget`:
+/// [`super::retriangulate::RetriStats`]), and `broken_after_retriangulation`: chains a later stage
+/// (clean-up, zero-area removal) left with a non-edge (none measured so far; counted so that it
+/// cannot hide).
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct SegmentsNotEdges {
+    pub total: usize,
+    pub pieces: usize,
+    pub off_surface: usize,
+    pub separated: usize,
+    pub budget: usize,
+    pub broken_after_retriangulation: usize,
+}
+
 pub struct Quality {
     pub curve_residual_max: f64,
     pub curve_residual_mean: f64,
     pub chain_deviation_max: f64,
     pub segments_as_edges: f64,
+    /// The share among the segments the template's topology allows as chains (all but
+    /// `pieces` and `off_surface`): 1 when every failure is one no chain can fix.
+    pub segments_as_edges_realisable: f64,
+    pub segments_not_edges: SegmentsNotEdges,
     /// Output faces turned against the template's normals pushed forward by the fit's maps
     /// ([`super::orientation`]).
     pub flipped_faces: usize,
@@ -130,6 +150,16 @@ impl Quality {
                 c.len() >= 2 && c.windows(2).all(|w| edges.contains_key(&(w[0].min(w[1]), w[0].max(w[1]))))
             })
             .count();
+        let st = &realised.stats;
+        let not_edges = SegmentsNotEdges {
+            total: realised.chains.len() - ok,
+            pieces: st.failed_pieces,
+            off_surface: st.off_surface_segments,
+            separated: st.failed_separated,
+            budget: st.failed_budget,
+            broken_after_retriangulation: (realised.chains.len() - ok).saturating_sub(st.failed_segments),
+        };
+        let realisable = realised.chains.len().saturating_sub(st.failed_pieces + st.off_surface_segments);
         // Retriangulation adds no vertices, so each output face has reference normals at its own
         // corners (no nearest-point search).
         let _ = reference_pos;
@@ -146,6 +176,12 @@ impl Quality {
             curve_residual_mean: res.iter().sum::<f64>() / res.len().max(1) as f64,
             chain_deviation_max: dev,
             segments_as_edges: ok as f64 / realised.chains.len().max(1) as f64,
+            segments_as_edges_realisable: if realisable == 0 {
+                1.0
+            } else {
+                ok.min(realisable) as f64 / realisable as f64
+            },
+            segments_not_edges: not_edges,
             flipped_faces: orientation.faces_against(pos, tris),
             faces_inverted_by_maps: orientation.faces_inverted(tris),
             flipped_faces_against_fine_surface: flipped,

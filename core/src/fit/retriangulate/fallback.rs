@@ -45,6 +45,9 @@ impl Work<'_> {
                     !over_gap && why == route::NoRoute::Separated && !route::on_one_piece(self.mesh, from, w);
                 self.stats.failed_pieces += usize::from(pieces);
                 self.stats.off_surface_segments += usize::from(over_gap);
+                let other = !pieces && !over_gap;
+                self.stats.failed_separated += usize::from(other && why == route::NoRoute::Separated);
+                self.stats.failed_budget += usize::from(other && why == route::NoRoute::Budget);
                 if self.stats.failed.len() < 20 {
                     self.stats.failed.push(FailedSegment {
                         segment: si,

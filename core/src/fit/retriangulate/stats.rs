@@ -51,6 +51,12 @@ pub struct RetriStats {
     /// chain of edges can follow them and a route around the gap would cut a spurious region off
     /// ([`super::off_surface`]). Close the template's holes (the repair job) to realise them.
     pub off_surface_segments: usize,
+    /// Of those, segments whose ends realised curves separate on one piece (route "separated":
+    /// crossing input, or curve vertices the fine stage left in a tangled order around a fold)
+    /// and segments whose route search ran out of budget: unlike the two above, these could be
+    /// chains on this template.
+    pub failed_separated: usize,
+    pub failed_budget: usize,
     /// Why walks stopped (one count per failed walk piece).
     pub walk_fail_start: usize,
     pub walk_fail_boundary: usize,
