@@ -13,8 +13,8 @@
 //! - both faces of a flipped edge, and all faces of a removed vertex, carry the same label (the
 //!   caller's region × template group), so regions are never merged and groups never mixed;
 //! - no resulting face is degenerate or turned against its reference ([`Reference::face`]: in
-//!   the fit, the template's normal carried by the fit's maps, the report's `flipped_faces`
-//!   reference), or against the face it replaces;
+//!   the fit, still the fine surface's vertex normals, see [`super::reference`]), or against the
+//!   face it replaces;
 //! - the edit strictly raises the worst smallest angle among the faces it changes (so the
 //!   process terminates) and keeps the shape: a flip sweeps a small volume relative to the two
 //!   faces, and a removed vertex lies close to the faces that replace its star;
@@ -92,7 +92,7 @@ pub struct Constraints<'a> {
     /// pulled onto a segment) → their two chain neighbours. Such a vertex may be removed into a
     /// chain neighbour: the three are on one segment, so the chain stays a chain of edges on it.
     pub chain: IntMap<u32, [u32; 2]>,
-    /// What each face should face (the fit's carried reference).
+    /// What each face should face (the fit passes the fine surface's vertex normals).
     pub reference: &'a dyn Reference,
     /// Per template vertex, the quality (sin² of the smallest angle) of the thinnest template
     /// face at it ([`template_floor`]); vertices past its end (added by the fit) have none.

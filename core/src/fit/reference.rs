@@ -3,15 +3,18 @@
 //! Why one trait: the report's `flipped_faces` counts faces against the template's normal carried
 //! by the fit's maps ([`super::orientation`]), and every stage that repairs folds (the untangling
 //! after the fine stage, after re-triangulation and after smoothing, the clean-up's guard, the
-//! smoothing's undo) must decide "folded" against that same reference, or it "fixes" faces toward
-//! another one. Until session 15 they used the area-weighted vertex normals of the fine-deformed
-//! surface: at a 135° crease of small template faces next to large ones those normals follow the
-//! large faces, and the untangling turned the small ones over (the headline's 3 flipped faces).
-//! Through [`Reference::face`] the repair and the count share one definition of a face's reference
+//! smoothing's undo) should decide "folded" against that same reference, or it "fixes" faces
+//! toward another one. They use the area-weighted vertex normals of the fine-deformed surface: at
+//! a 135° crease of small template faces next to large ones those normals follow the large faces,
+//! and the untangling turns the small ones over (the headline's 3 flipped faces). Through
+//! [`Reference::face`] the repair and the count can share one definition of a face's reference
 //! ([`super::orientation::Orientation`] implements it with the count's own function).
 //!
-//! The plain per-vertex normals ([`Vec<Point3>`]: a face's reference is the sum of its corners'
-//! normals) stay for the untangling's unit tests and callers without maps.
+//! **Not switched on (session 15):** the pipeline still passes the plain per-vertex normals
+//! ([`Vec<Point3>`]: a face's reference is the sum of its corners' normals). Passing the
+//! `Orientation` halved the report's count on `sweep_deformed` but raised the faces against the
+//! independent truth surface (19,372 → 19,642–19,678) and failed a CAD test
+//! (docs/benchmarks.md, session 15).
 
 use crate::geometry::{add, normalize};
 use crate::mesh::Point3;

@@ -1,7 +1,7 @@
 //! Untangling folded faces: a face is *folded* when its normal opposes (or is perpendicular to,
-//! within [`MIN_COS`]) its reference ([`Reference::face`]: in the fit, the template's normal
-//! carried by the fit's maps, the report's `flipped_faces` reference; in the unit tests, vertex
-//! normals). Used three times: after the fine deformation (curve vertices fixed), after the
+//! within [`MIN_COS`]) its reference ([`Reference::face`]: in the fit, still the vertex normals
+//! of the surface before the stage, not the report's carried reference, see
+//! [`super::reference`]). Used three times: after the fine deformation (curve vertices fixed), after the
 //! re-triangulation (chain vertices fixed, curve edges locked) and after smoothing.
 //!
 //! Fixes are local and only accepted when they leave no folded face among the faces they touch
