@@ -182,15 +182,15 @@ pub fn approach(
             continue;
         }
         let Ok(field) = Rbf::fit(&centres, &values, kernel, "fine") else { continue };
-        // Shared with the orientation count, which may evaluate its Jacobian again exactly.
-        let field = std::sync::Arc::new(field);
-        let mut disp = field.eval_many(pos, progress)?;
+        // The field's gradients from the same sums, for the orientation count below.
+        let (mut disp, mut gradients) = field.eval_with_gradients(pos, progress)?;
         let targets: Vec<Point3> = sample.iter().map(|&p| net.points[p as usize]).collect();
         let refined = super::field_refine::refine_for_field(
             pos, tris, parents, &mut disp, &field, &targets, &feet, gate, progress,
         )?;
         if refined.faces_added > 0 {
             vf = super::insert::vertex_faces(pos.len(), tris);
+            gradients.extend(field.eval_with_gradients(&pos[gradients.len()..], progress)?.1);
         }
         report.refined.push(refined);
         let mut step = 1.0;
@@ -208,7 +208,7 @@ pub fn approach(
         }
         // The template's normals through this level's map, x ↦ x + step · s(x).
         orientation.sync(parents);
-        orientation.push_field(pos, field.clone(), step, progress)?;
+        orientation.push_gradients(pos, &gradients, step);
         pos.copy_from_slice(&moved);
         for &(p, v) in fixed {
             pos[v as usize] = net.points[p as usize];

@@ -8,7 +8,7 @@ use crate::geometry::{add, dist, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
-use super::coarse::{fit_rbf, plus_identity, CoarseReport};
+use super::coarse::{fit_rbf, CoarseReport};
 use super::insert::coincident;
 use super::orientation::Orientation;
 use super::rbf::{Gradient, Rbf};
@@ -132,7 +132,7 @@ pub(super) fn fine_dispatch(
                     pos.len()
                 )));
             }
-            orientation.push(pos, |v, _| plus_identity(gradients[v]));
+            orientation.push_gradients(pos, &gradients, 1.0);
             Ok(fine)
         }
         Matching::NearestVertex => {

@@ -405,9 +405,10 @@ impl Orientation {
 
     /// Composes every vertex's Jacobian with the map x ↦ x + step · field(x), the field's
     /// gradients summed in single precision with error bounds ([`Rbf::gradients_bounded`]): the
-    /// fit's RBF maps, ~100k vertices × ~2k centres each. Keeps what the count needs to evaluate
-    /// them again exactly where a face's decision is open. Returns how many vertices the map
-    /// inverts by the single-precision values.
+    /// fine RBF of `matching = nearest_vertex` (the approach levels and the inserted fine stage
+    /// compute their gradients with the values instead: [`Orientation::push_gradients`]). Keeps
+    /// what the count needs to evaluate them again exactly where a face's decision is open.
+    /// Returns how many vertices the map inverts by the single-precision values.
     pub fn push_field(
         &mut self,
         before: &[Point3],
@@ -431,6 +432,14 @@ impl Orientation {
             r.steps.push(Step::Field { field, step, before: before[..n].to_vec() });
         }
         Ok(inverted)
+    }
+
+    /// Composes every vertex's Jacobian with the map x ↦ x + step · field(x) from the field's
+    /// gradient at each vertex's position before the map (`gradients[v]`, computed in double
+    /// precision with the field's values: [`Rbf::eval_with_gradients`]): exact, no bound. Returns
+    /// how many vertices the map inverts.
+    pub fn push_gradients(&mut self, before: &[Point3], gradients: &[Jacobian], step: f64) -> usize {
+        self.push(&before[..gradients.len().min(before.len())], |v, _| field_step(&gradients[v], step))
     }
 
     /// Multiplies every vertex's Jacobian by its step on the left; `bound(v)`: the step's error

@@ -4,7 +4,10 @@
 //! the headline's ~1.4 s (fit-flipcount, sessions 13–14); the count only needs the sign of dot
 //! products, so 8 lanes of f32 with a reciprocal square root do the sum, and each point gets a
 //! bound on the error of its Jacobian. The count re-evaluates in double precision
-//! ([`Rbf::gradient`]) only the corners of faces whose decision the bound leaves open.
+//! ([`Rbf::gradient`]) only the corners of faces whose decision the bound leaves open. Since
+//! session 16 the approach levels and the inserted fine stage take their gradients from the pass
+//! that evaluates the field ([`Rbf::eval_with_gradients`], double precision, no second pass);
+//! this one serves the fine stage of `matching = nearest_vertex`.
 //!
 //! The bound (normalised frame, u = 2⁻²⁴, per entry of the gradient, |α_i| = max over the three
 //! coordinates of centre i's weight, M = the largest coordinate of the point and the centres):
