@@ -8,10 +8,10 @@ use crate::geometry::{add, dist, sub};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
-use super::coarse::{fit_rbf, CoarseReport};
+use super::coarse::{fit_rbf, plus_identity, CoarseReport};
 use super::insert::coincident;
 use super::orientation::Orientation;
-use super::rbf::Rbf;
+use super::rbf::{Gradient, Rbf};
 use super::{approach, correspond, curves, flips, insert, FitParams, Matching};
 
 /// The fine stage's result.
@@ -119,23 +119,36 @@ pub(super) fn fine_dispatch(
     orientation: &mut Orientation,
     progress: &Progress,
 ) -> Result<Fine> {
-    let (fine, field) = match params.matching {
+    // The template's normals through the fine RBF, at every vertex the stage kept.
+    match params.matching {
         Matching::Insert => {
-            fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)?
+            let (fine, gradients) =
+                fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)?;
+            orientation.sync(parents);
+            if gradients.len() != pos.len() {
+                return Err(Error::Internal(format!(
+                    "fine stage: {} field gradients for {} vertices",
+                    gradients.len(),
+                    pos.len()
+                )));
+            }
+            orientation.push(pos, |v, _| plus_identity(gradients[v]));
+            Ok(fine)
         }
         Matching::NearestVertex => {
-            fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress)?
+            let (fine, field) = fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress)?;
+            orientation.sync(parents);
+            orientation.push_field(pos, std::sync::Arc::new(field), 1.0, progress)?;
+            Ok(fine)
         }
-    };
-    // The template's normals through the fine RBF, at every vertex the stage kept.
-    orientation.sync(parents);
-    orientation.push_field(pos, std::sync::Arc::new(field), 1.0, progress)?;
-    Ok(fine)
+    }
 }
 
 /// The fine stage with `Matching::Insert`: split the template at the curve vertices' feet, solve
 /// the RBF once, and handle flips by subdividing the flagged faces under the *same* field (the
-/// centres never change, so only the new midpoints are evaluated: no re-solve per round).
+/// centres never change, so only the new midpoints are evaluated: no re-solve per round). Also
+/// returns the field's gradient at every vertex before the move, from the same sums as the
+/// values ([`Rbf::eval_with_gradients`]).
 #[allow(clippy::too_many_arguments)]
 fn fine_fit_inserted(
     pos: &mut Vec<Point3>,
@@ -147,7 +160,7 @@ fn fine_fit_inserted(
     parents: &mut Vec<[(u32, f64); 3]>,
     search: insert::FootSearch,
     progress: &Progress,
-) -> Result<(Fine, Rbf)> {
+) -> Result<(Fine, Vec<Gradient>)> {
     let pair_fixed = coarse.pair_fixed(&params.pairs);
     let clock = std::time::Instant::now();
     let mut steps_ms = [0.0; 4];
@@ -189,7 +202,7 @@ fn fine_fit_inserted(
     let f = fit_rbf(centres, values, params, "fine", "curves", &name, progress)?;
     lap(1);
     let augmented = f.in_plane();
-    let disp = f.eval_many(pos, progress)?;
+    let (disp, mut gradients) = f.eval_with_gradients(pos, progress)?;
     let mut moved: Vec<Point3> = pos.iter().zip(&disp).map(|(p, d)| add(*p, *d)).collect();
     for (p, &v) in vop.iter().enumerate() {
         moved[v as usize] = net.points[p]; // exact, not RBF round-off
@@ -206,8 +219,9 @@ fn fine_fit_inserted(
         progress.check()?;
         let (p0, t0, par0) = (pos.len(), tris.clone(), parents.len());
         let added = flips::subdivide(pos, tris, &scan.flipped, parents);
-        let d = f.eval_many(&pos[p0..], progress)?;
+        let (d, g) = f.eval_with_gradients(&pos[p0..], progress)?;
         moved.extend(pos[p0..].iter().zip(d).map(|(p, d)| add(*p, d)));
+        gradients.extend(g);
         let next = flips::detect_polled(pos, &moved, tris, progress)?;
         flagged_per_round.push(next.flipped.len());
         rounds += 1;
@@ -215,6 +229,7 @@ fn fine_fit_inserted(
             // No better under this field: undo the round (smaller faces fold the same way).
             pos.truncate(p0);
             moved.truncate(p0);
+            gradients.truncate(p0);
             parents.truncate(par0);
             *tris = t0;
             break;
@@ -246,7 +261,7 @@ fn fine_fit_inserted(
             approach_ms: 0.0,
         },
     };
-    Ok((fine, f))
+    Ok((fine, gradients))
 }
 
 /// The template's UVs extended to the vertices the fit added (each a weighted combination of

@@ -28,8 +28,10 @@ use super::kdtree::KdTree;
 mod cpd_solve;
 mod gradient;
 mod system;
+mod with_gradient;
 
 pub use gradient::BoundedGradient;
+pub use with_gradient::Gradient;
 
 pub use system::{CHOLESKY_CENTRES, CHOLESKY_MIN_SPREAD};
 
@@ -295,18 +297,28 @@ impl Rbf {
 
     /// The field's value at `p`.
     pub fn eval(&self, p: Point3) -> Point3 {
-        let q = [
+        self.eval_normalised(self.normalised(p))
+    }
+
+    /// `p` in the normalised coordinates of the centres.
+    #[inline]
+    fn normalised(&self, p: Point3) -> Point3 {
+        [
             (p[0] - self.origin[0]) / self.scale,
             (p[1] - self.origin[1]) / self.scale,
             (p[2] - self.origin[2]) / self.scale,
-        ];
-        self.eval_normalised(q)
+        ]
     }
 
     /// The field's value at `q` in the normalised coordinates of the centres.
     #[inline]
     fn eval_normalised(&self, q: Point3) -> Point3 {
-        let (sx, sy, sz) = self.radial(q);
+        self.with_affine(q, self.radial(q))
+    }
+
+    /// The radial sums at `q` plus the polynomial part there: the field's value.
+    #[inline]
+    fn with_affine(&self, q: Point3, (sx, sy, sz): (f64, f64, f64)) -> Point3 {
         let a = &self.affine;
         [
             sx + a[0][0] * q[0] + a[1][0] * q[1] + a[2][0] * q[2] + a[3][0],
