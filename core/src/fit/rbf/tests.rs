@@ -213,23 +213,30 @@ fn the_gradient_matches_finite_differences() {
     }
 }
 
+/// `n` centres on a wobbly sphere with smooth displacements, and `m` scattered points around them
+/// (the two gradient tests' field).
+fn scattered_field(n: usize, m: usize) -> (Vec<Point3>, Vec<Point3>, Vec<Point3>) {
+    let c: Vec<Point3> = (0..n)
+        .map(|i| {
+            let (a, b) = (i as f64 * 0.61, i as f64 * 0.237);
+            [a.cos() * b.sin() * (1.0 + 0.1 * (3.0 * a).sin()), a.sin() * b.sin(), b.cos() + 0.05 * a.cos()]
+        })
+        .collect();
+    let vals =
+        c.iter().map(|p| [0.3 * p[1] * p[2], 0.2 * (3.0 * p[0]).sin(), -0.25 * p[0] * p[1] + 0.1]).collect();
+    let points = (0..m)
+        .map(|i| [(i as f64 * 0.77).sin() * 1.3, (i as f64 * 0.31).cos(), (i % 9) as f64 * 0.2 - 0.8])
+        .collect();
+    (c, vals, points)
+}
+
 /// The single-precision gradients ([`Rbf::gradients_bounded`]) stay within their error bounds of
 /// the exact ones: far from the centres, 1e-7 from one and on one (where the exact gradient leaves
 /// that centre out). Away from the centres the bounds are small, so the orientation count decides
 /// nearly every face from them. The cubic kernel is exact (bound 0).
 #[test]
 fn single_precision_gradients_stay_within_their_bounds() {
-    let c: Vec<Point3> = (0..400)
-        .map(|i| {
-            let (a, b) = (i as f64 * 0.61, i as f64 * 0.237);
-            [a.cos() * b.sin() * (1.0 + 0.1 * (3.0 * a).sin()), a.sin() * b.sin(), b.cos() + 0.05 * a.cos()]
-        })
-        .collect();
-    let vals: Vec<Point3> =
-        c.iter().map(|p| [0.3 * p[1] * p[2], 0.2 * (3.0 * p[0]).sin(), -0.25 * p[0] * p[1] + 0.1]).collect();
-    let mut points: Vec<Point3> = (0..50)
-        .map(|i| [(i as f64 * 0.77).sin() * 1.3, (i as f64 * 0.31).cos(), (i % 9) as f64 * 0.2 - 0.8])
-        .collect();
+    let (c, vals, mut points) = scattered_field(400, 50);
     let far = points.len();
     points.push(c[5]);
     points.push([c[17][0] + 1e-7, c[17][1], c[17][2]]);
@@ -263,17 +270,7 @@ fn single_precision_gradients_stay_within_their_bounds() {
 /// points away from the centres, on one and 1e-9 from one; the cubic kernel takes the plain path.
 #[test]
 fn fused_values_and_gradients_match_the_separate_ones() {
-    let c: Vec<Point3> = (0..403)
-        .map(|i| {
-            let (a, b) = (i as f64 * 0.61, i as f64 * 0.237);
-            [a.cos() * b.sin() * (1.0 + 0.1 * (3.0 * a).sin()), a.sin() * b.sin(), b.cos() + 0.05 * a.cos()]
-        })
-        .collect();
-    let vals: Vec<Point3> =
-        c.iter().map(|p| [0.3 * p[1] * p[2], 0.2 * (3.0 * p[0]).sin(), -0.25 * p[0] * p[1] + 0.1]).collect();
-    let mut points: Vec<Point3> = (0..300)
-        .map(|i| [(i as f64 * 0.77).sin() * 1.3, (i as f64 * 0.31).cos(), (i % 9) as f64 * 0.2 - 0.8])
-        .collect();
+    let (c, vals, mut points) = scattered_field(403, 300);
     points.push(c[5]);
     points.push([c[17][0] + 1e-9, c[17][1], c[17][2]]);
     for kernel in [Kernel::Linear, Kernel::Cubic] {

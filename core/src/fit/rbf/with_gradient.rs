@@ -54,14 +54,18 @@ impl Rbf {
         Ok((values, grads))
     }
 
+    /// Without the fused kernel (not x86-64; `eval_with_gradients` never calls it there).
+    #[cfg(not(target_arch = "x86_64"))]
+    fn eval_and_gradient(&self, p: Point3) -> (Point3, Gradient) {
+        (self.eval(p), self.gradient(p))
+    }
+
     /// The value and gradient at `p` from one fused sum (linear kernel, AVX2 + FMA checked).
+    #[cfg(target_arch = "x86_64")]
     fn eval_and_gradient(&self, p: Point3) -> (Point3, Gradient) {
         let q = self.normalised(p);
-        #[cfg(target_arch = "x86_64")]
         // SAFETY: `eval_with_gradients` calls this only after detecting AVX2 and FMA.
         let (radial, sums) = unsafe { self.radial_and_gradient_avx2(q) };
-        #[cfg(not(target_arch = "x86_64"))]
-        let (radial, sums) = (self.radial(q), [0.0; 9]);
         let mut g = [[0.0; 3]; 3];
         for (r, row) in g.iter_mut().enumerate() {
             for (c, x) in row.iter_mut().enumerate() {
