@@ -46,6 +46,7 @@ pub mod template;
 pub mod testdata;
 pub mod thin;
 pub mod trimesh;
+pub mod turned;
 pub mod untangle;
 pub mod uvs;
 
@@ -458,6 +459,36 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
         }
     }
+    // The last repair, on the faces the report's count calls turned and only those (the stages
+    // before judge against the surface's vertex normals, which at a sharp crease of small faces
+    // follow the large ones: docs/benchmarks.md, flips17): curve vertices and the boundary fixed,
+    // curve edges locked; an edit must lower the count where it acts and add no folded edge.
+    // Every vertex the fit added takes its parents' maps first.
+    orientation.sync(&parents);
+    if orientation.len() != mesh.pos.len() {
+        return Err(Error::Internal(format!(
+            "fit: {} pushed-forward normals for {} vertices (a vertex added without parents)",
+            orientation.len(),
+            mesh.pos.len()
+        )));
+    }
+    let turned = stages.run(progress, "turned_faces", || {
+        let mut fixed_now = fixed.clone();
+        fixed_now.resize(mesh.pos.len(), true);
+        turned::repair_counted(&mut mesh, &orientation, &fixed_now, &curve_edges, progress)
+    })?;
+    if turned.vertex_moves > 0 {
+        out_pos.clone_from(&mesh.pos);
+    }
+    if turned.edge_flips > 0 {
+        // Flipped edges are never curve edges: the regions are the same, relabelled for the new
+        // face list.
+        out_tris = mesh.live_triangles();
+        (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
+        if keep_groups {
+            tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
+        }
+    }
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
     // Vertices removed by the clean-up leave the output; every per-vertex array is renumbered.
@@ -472,8 +503,6 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut vertex_of_point = fine.vertex_of_point.clone();
     keep.apply(&mut vertex_of_point);
     let reference_normals = keep.vec(&reference_normals);
-    // Vertices the re-triangulation and its untangling added take their parents' normals.
-    orientation.sync(&parents);
     if orientation.len() != keep_len {
         return Err(Error::Internal(format!(
             "fit: {} pushed-forward normals for {keep_len} vertices (a vertex added without parents)",
@@ -527,6 +556,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         if let Some(s) = &untangle_smoothed {
             uvs::apply_batches(&mut uvs, &s.uv_batches);
         }
+        uvs::apply_batches(&mut uvs, &turned.uv_batches);
         keep.vec(&uvs)
     });
     out.groups = group_names;
@@ -558,6 +588,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         moved_vertices.extend(s.uv_batches.iter().flatten().map(|m| m.vertex));
     }
     moved_vertices.extend_from_slice(&smooth_moved);
+    moved_vertices.extend(turned.uv_batches.iter().flatten().map(|m| m.vertex));
     moved_vertices.sort_unstable();
     moved_vertices.dedup();
     let mut report = serde_json::json!({
@@ -620,6 +651,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "ratio": mesh.peak_faces() as f64 / face_base.max(1) as f64,
         "limit": params.max_face_growth,
     });
+    report["turned_faces"] = serde_json::to_value(&turned).unwrap_or_default();
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })

@@ -561,6 +561,31 @@ impl Orientation {
         against
     }
 
+    /// Whether one face is counted by [`Orientation::faces_against`]: the same decision, face by
+    /// face (stored Jacobians, exact ones where the bounds leave it open). For the last repair
+    /// ([`super::turned`]), which must judge its edits by the count itself.
+    pub fn face_against(&self, pos: &[Point3], t: &[u32; 3]) -> bool {
+        let stored = |v: u32| (self.jacobians[v as usize], self.errors[v as usize]);
+        match self.decide(pos, t, stored) {
+            Decision::Against => true,
+            Decision::With => false,
+            Decision::Open => {
+                let exact = self.exact_at(t.iter().copied());
+                let d = match self.decide(pos, t, |v| exact(v)) {
+                    Decision::Open => self.decide(pos, t, |v| (stored(v).0, 0.0)),
+                    d => d,
+                };
+                d == Decision::Against
+            }
+        }
+    }
+
+    /// The count's reference direction of face `t` (stored Jacobians, no bound): where a face
+    /// should point, for the last repair's tangent planes.
+    pub fn counted_direction(&self, t: &[u32; 3]) -> Point3 {
+        self.reference_with(t, Side::Covector, |v| (self.jacobians[v as usize], 0.0)).0
+    }
+
     /// Faces with at least two corners where the composite map turns space inside out (det J ≤ 0),
     /// corners whose sign the bound leaves open decided with exact Jacobians.
     pub fn faces_inverted(&self, tris: &[[u32; 3]]) -> usize {

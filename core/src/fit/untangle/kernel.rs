@@ -17,7 +17,7 @@ const MAX_RING: usize = 24;
 /// The kernel's Chebyshev centre of `v`'s star `faces` (each given as its two other corners
 /// (x, y) in the face's order after `v`) seen along unit normal `n`, lifted to the mean height of
 /// the ring over the plane; None when the kernel is empty or the ring too large.
-pub(super) fn kernel_centre(ring_edges: &[(Point3, Point3)], n: Point3) -> Option<Point3> {
+pub(crate) fn kernel_centre(ring_edges: &[(Point3, Point3)], n: Point3) -> Option<Point3> {
     if ring_edges.is_empty() || ring_edges.len() > MAX_RING {
         return None;
     }

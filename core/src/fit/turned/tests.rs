@@ -1,0 +1,87 @@
+use super::*;
+use crate::geometry::triangle_cross;
+
+/// A regular hexagon (radius 1, plane z = 0, counter-clockwise) around centre vertex 6.
+fn hexagon_fan(centre: Point3) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut pos: Vec<Point3> = (0..6)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 6.0;
+            [a.cos(), a.sin(), 0.0]
+        })
+        .collect();
+    pos.push(centre);
+    (pos, (0..6).map(|k| [k, (k + 1) % 6, 6]).collect())
+}
+
+fn up_faces(mesh: &TriMesh) -> usize {
+    mesh.alive_faces().filter(|&f| mesh.face_normal(f)[2] > 0.0).count()
+}
+
+/// The centre at (0.9, 0.5) is beyond ring edge 0→1 only (by hand: cross((−0.5, 0.866), (−0.1,
+/// 0.5)) = −0.163 < 0, the other five edges positive), so exactly face (0, 1, 6) points down
+/// against the reference +z. Flipping its two inner edges leaves a face down (by hand: (2, 6, 0)
+/// and (1, 6, 5) have cross −0.66 and −0.69), so the fix is the centre's move: to the ring's mean,
+/// the origin, where all six faces point up. The ring is the boundary and never moves.
+#[test]
+fn a_face_turned_by_a_free_corner_is_turned_back_by_moving_it() {
+    let (pos, tris) = hexagon_fan([0.9, 0.5, 0.0]);
+    let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
+    assert_eq!(up_faces(&mesh), 5);
+    let reference = vec![[0.0, 0.0, 1.0]; 7];
+    let fixed = [true, true, true, true, true, true, false];
+    let s = repair_counted(&mut mesh, &reference, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.fixed, s.left, s.vertex_moves, s.edge_flips), (1, 1, 0, 1, 0), "{s:?}");
+    assert_eq!(up_faces(&mesh), 6);
+    assert_eq!(&mesh.pos[..6], &pos[..6]);
+    assert!(mesh.pos[6][0].abs() < 1e-12 && mesh.pos[6][1].abs() < 1e-12, "{:?}", mesh.pos[6]);
+    assert_eq!(s.uv_batches.len(), 1);
+}
+
+/// The same with the report's own count: a template hexagon under the identity maps (the count's
+/// reference is each template face's normal, +z), the output's centre moved as above. The
+/// count says 1 before the pass and 0 after.
+#[test]
+fn the_reports_count_is_what_the_pass_lowers() {
+    let (template, tris) = hexagon_fan([0.0, 0.0, 0.0]);
+    let orientation = Orientation::new(&template, &tris);
+    let (pos, _) = hexagon_fan([0.9, 0.5, 0.0]);
+    let mut mesh = TriMesh::new(pos, tris.clone()).unwrap();
+    assert_eq!(orientation.faces_against(&mesh.pos, &tris), 1);
+    let fixed = [true, true, true, true, true, true, false];
+    let s = repair_counted(&mut mesh, &orientation, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.left), (1, 0), "{s:?}");
+    assert_eq!(orientation.faces_against(&mesh.pos, &mesh.live_triangles()), 0);
+}
+
+/// Faces (0, 1, 2) up and (0, 2, 3) down (vertex 3 = (1, −0.3) on vertex 1's side of 0→2), all
+/// vertices fixed: flipping 0–2 into 1–3 gives (3, 0, 1) and (1, 2, 3), both up (by hand: cross
+/// 0.7 and 0.7). With two more down faces glued to (0, 2, 3) on its other edges (both locked, as
+/// curve edges), the two new faces would each be folded against one of them (180°) where only
+/// one edge was folded before: the pass leaves the face and counts the refusal.
+#[test]
+fn a_flip_is_made_unless_it_folds_a_neighbour() {
+    let quad = vec![[0.0, 0.0, 0.0], [1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, -0.3, 0.0]];
+    let up = vec![[0.0, 0.0, 1.0]; 6];
+    let mut mesh = TriMesh::new(quad.clone(), vec![[0, 1, 2], [0, 2, 3]]).unwrap();
+    let s = repair_counted(&mut mesh, &up, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.edge_flips, s.left, s.refused_fold), (1, 1, 0, 0), "{s:?}");
+    assert!(mesh.has_edge(1, 3) && !mesh.has_edge(0, 2));
+    assert_eq!(up_faces(&mesh), 2);
+
+    // (3, 2, 4) and (0, 3, 5) point down (by hand: cross −0.545 each), glued along 3–2 and 0–3.
+    let mut pos = quad.clone();
+    pos.push([1.65, -0.65, 0.0]);
+    pos.push([0.35, -0.65, 0.0]);
+    let tris = vec![[0, 1, 2], [0, 2, 3], [3, 2, 4], [0, 3, 5]];
+    let mut mesh = TriMesh::new(pos, tris).unwrap();
+    assert_eq!(up_faces(&mesh), 1);
+    let mut locked = EdgeSet::default();
+    locked.insert((2, 3));
+    locked.insert((0, 3));
+    let s = repair_counted(&mut mesh, &up, &[true; 6], &locked, &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.edge_flips, s.vertex_moves, s.left), (3, 0, 0, 3), "{s:?}");
+    assert!(s.refused_fold >= 1, "{s:?}");
+    assert!(mesh.has_edge(0, 2) && !mesh.has_edge(1, 3));
+    let n = triangle_cross(mesh.pos[0], mesh.pos[2], mesh.pos[3]);
+    assert!(n[2] < 0.0);
+}
