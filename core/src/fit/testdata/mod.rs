@@ -8,6 +8,7 @@
 //! - [`templates`]: templates beyond the icosphere (cylinder, paraboloid with a hole, n-gon sphere)
 //!   and mesh edits (holes, two meshes as one, a zero-area face);
 //! - [`checks`]: checks of an output against the truth (faces turned against its normal);
+//! - [`heldout`]: other smooth maps and oblique planes, the held-out family of the deformed sweep;
 //! - [`files`]: curve files as other programs write them (glTF lines with and without node
 //!   transforms, OBJ negative indices).
 //!
@@ -16,11 +17,13 @@
 pub mod checks;
 pub mod curves;
 pub mod files;
+pub mod heldout;
 pub mod sections;
 pub mod templates;
 
 pub use checks::*;
 pub use curves::*;
 pub use files::*;
+pub use heldout::*;
 pub use sections::*;
 pub use templates::*;

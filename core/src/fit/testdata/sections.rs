@@ -201,7 +201,9 @@ pub fn thin_network(curves: &Mesh, k: usize) -> Mesh {
 /// nearest to the crossing on the *undeformed* surface ↔ the crossing moved by `map`. The vertex is
 /// taken on the piece of the template under the crossing (the piece of its closest face): a user
 /// clicks the surface the crossing lies on, not a vertex of another piece that happens to be nearer
-/// (suzanne's eyes under crossings on its head; the nearest vertex overall sent them there).
+/// (suzanne's eyes under crossings on its head; the nearest vertex overall sent them there). A
+/// crossing whose vertex another crossing already took is skipped: a user does not pin one vertex to
+/// two points (the fit rejects that), so two crossings inside one coarse face give one pair.
 pub fn crossing_pairs(
     curves: &Mesh,
     template: &Mesh,
@@ -230,6 +232,7 @@ pub fn crossing_pairs(
         let d = sub(template.positions[v], p);
         dot(d, d)
     };
+    let mut used = std::collections::HashSet::new();
     crossings
         .iter()
         .step_by(step)
@@ -240,7 +243,7 @@ pub fn crossing_pairs(
             let v = (0..template.positions.len())
                 .filter(|&v| on.is_none_or(|k| vertex_piece[v] == Some(k)))
                 .min_by(|&a, &b| d2(a, p).total_cmp(&d2(b, p)))?;
-            Some(crate::fit::FitPair { template_vertex: v as u32, curve_point: map(p) })
+            used.insert(v).then(|| crate::fit::FitPair { template_vertex: v as u32, curve_point: map(p) })
         })
         .collect()
 }
@@ -417,5 +420,31 @@ mod crossing_pair_tests {
         let nearest = (0..t.positions.len() as u32).min_by(|&a, &b| d2(a).total_cmp(&d2(b))).unwrap();
         assert!(nearest >= base, "the set-up must put another piece nearest");
         assert!(f.contains(&v), "paired with vertex {v}, not a corner {f:?} of the face under the crossing");
+    }
+
+    /// Two crossings close together on a coarse icosahedron's face share their nearest corner: the
+    /// second is skipped (one pair, not two pairs on one vertex, which the fit rejects).
+    #[test]
+    fn two_crossings_nearest_one_vertex_give_one_pair() {
+        let t = icosphere(0, 1.0);
+        let f: Vec<u32> = t.faces.get(0).to_vec();
+        let corner = t.positions[f[0] as usize];
+        let towards = t.positions[f[1] as usize];
+        // Two crossings 5 % and 10 % of the way from corner 0 to corner 1: both nearest corner 0.
+        let a = add(corner, scale(sub(towards, corner), 0.05));
+        let b = add(corner, scale(sub(towards, corner), 0.10));
+        let arm = scale(sub(t.positions[f[2] as usize], corner), 0.01);
+        let mut positions = vec![a, b];
+        let mut curves = Vec::new();
+        for (c, p) in [(0u32, a), (1u32, b)] {
+            for s in [1.0, -1.0, 2.0, -2.0] {
+                positions.push(add(p, scale(arm, s)));
+                curves.push(vec![c, positions.len() as u32 - 1]);
+            }
+        }
+        let net = Mesh { positions, curves, ..Default::default() };
+        let pairs = crossing_pairs(&net, &t, 12, |p| p);
+        assert_eq!(pairs.len(), 1, "{:?}", pairs.iter().map(|p| p.template_vertex).collect::<Vec<_>>());
+        assert_eq!(pairs[0].template_vertex, f[0]);
     }
 }
