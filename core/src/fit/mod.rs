@@ -11,6 +11,8 @@
 //! 4. `retriangulate`: every curve segment becomes a chain of mesh edges ([`retriangulate`]).
 //! 5. `partition`: faces labelled by region ([`partition`]).
 //! 6. `smooth`: tangential flows with the curves fixed ([`smooth`]).
+//! 7. `turned_faces`: the faces the report's `flipped_faces` counts, repaired by local edits that
+//!    add no fold ([`turned`]).
 //!
 //! The output mesh has one face group per region and carries the curves as vertex chains.
 //!

@@ -586,6 +586,12 @@ impl Orientation {
         self.reference_with(t, Side::Covector, |v| (self.jacobians[v as usize], 0.0)).0
     }
 
+    /// Whether the composite map turns space inside out (det J ≤ 0, stored Jacobians) at a corner
+    /// of face `t`: there the count's reference is reversed against the maps' image.
+    pub fn inverted_at_a_corner(&self, t: &[u32; 3]) -> bool {
+        t.iter().any(|&v| !(det(&self.jacobians[v as usize]) > 0.0))
+    }
+
     /// Faces with at least two corners where the composite map turns space inside out (det J ≤ 0),
     /// corners whose sign the bound leaves open decided with exact Jacobians.
     pub fn faces_inverted(&self, tris: &[[u32; 3]]) -> usize {

@@ -85,3 +85,22 @@ fn a_flip_is_made_unless_it_folds_a_neighbour() {
     let n = triangle_cross(mesh.pos[0], mesh.pos[2], mesh.pos[3]);
     assert!(n[2] < 0.0);
 }
+
+/// The template hexagon under a mirror map (z ↦ −z, det J = −1 at every vertex): the count's
+/// reference at each face is −z (J⁻ᵀ·(+z) = −z), so the five faces pointing up are counted. The
+/// maps turned space inside out there, so the reference is reversed against the surface and the
+/// pass must not "fix" them: nothing tried, nothing moved, all five reported as skipped.
+#[test]
+fn faces_where_the_maps_invert_space_are_left_and_reported() {
+    let (template, tris) = hexagon_fan([0.0, 0.0, 0.0]);
+    let mut orientation = Orientation::new(&template, &tris);
+    orientation.push(&template, |_, _| [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]);
+    let (pos, _) = hexagon_fan([0.9, 0.5, 0.0]);
+    let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
+    assert_eq!(orientation.faces_against(&mesh.pos, &tris), 5);
+    let fixed = [true, true, true, true, true, true, false];
+    let s = repair_counted(&mut mesh, &orientation, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.skipped_inverted_by_maps, s.tried, s.left), (5, 5, 0, 5), "{s:?}");
+    assert_eq!(mesh.pos, pos);
+    assert_eq!(mesh.live_triangles(), tris);
+}
