@@ -23,6 +23,7 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::curves::CurveNetwork;
+use super::orientation::{det, Jacobian};
 use super::rbf::{self, Kernel, Rbf};
 
 #[derive(Debug, Clone, Default, Serialize)]
@@ -46,6 +47,9 @@ pub struct ApproachReport {
     /// Sampled curve points per level whose foot was moved from a sheet to the rim, because they
     /// lie between the template's two sheets near its rim ([`super::thin`]).
     pub rim_feet: Vec<usize>,
+    /// Levels whose field was fitted again with the in-plane polynomial, because on their nearly
+    /// flat centres the full affine part turned space inside out ([`level_field`]).
+    pub in_plane_fields: usize,
 }
 
 /// Field refinement gate ([`super::field_refine`]): a level's sample missed by more than this
@@ -181,9 +185,14 @@ pub fn approach(
         if rbf::check_centres(&centres).is_err() || rbf::spread_ratios(&centres)[0] < 1e-3 {
             continue;
         }
-        let Ok(field) = Rbf::fit(&centres, &values, kernel, "fine") else { continue };
-        // The field's gradients from the same sums, for the orientation count below.
-        let (mut disp, mut gradients) = field.eval_with_gradients(pos, progress)?;
+        // The field, its values and gradients at every vertex (the gradients for the orientation
+        // count below and the inside-out check).
+        let Some((field, mut disp, mut gradients, in_plane)) =
+            level_field(&centres, &values, kernel, pos, progress)?
+        else {
+            continue;
+        };
+        report.in_plane_fields += in_plane as usize;
         let targets: Vec<Point3> = sample.iter().map(|&p| net.points[p as usize]).collect();
         let refined = super::field_refine::refine_for_field(
             pos, tris, parents, &mut disp, &field, &targets, &feet, gate, progress,
@@ -230,6 +239,49 @@ pub fn approach(
         report.step.push(step);
     }
     Ok(report)
+}
+
+/// Centres thinner than this share of their extent (the smallest principal spread over the
+/// largest, [`rbf::spread_ratios`]) may get the in-plane polynomial ([`level_field`]).
+const NEAR_FLAT_CENTRES: f64 = 0.1;
+
+/// A level's field, its displacements and gradients at `pos`, and whether it is the in-plane fit;
+/// `None` when the centres admit no field (the level is skipped).
+///
+/// Why not always the full affine part: on nearly flat centres (a flat template under wavy curves)
+/// its column along the normal is set by the centres' small out-of-plane spread alone and can come
+/// out arbitrary. Measured (docs/benchmarks.md, session 17): alligator under the held-out wave,
+/// centres 0.039 thick, det(I + ∇s) was −0.6 at every vertex: the surface was right (4 faces
+/// against the truth), but the map had turned space inside out, so the count's carried normal
+/// J⁻ᵀ·n called 6,765 faces flipped. Then, and only then (most vertices inside out), the field is
+/// fitted again with the in-plane polynomial: even about the centres' plane, its normal
+/// derivative comes from the kernel terms and vanishes on the plane, and it still interpolates the
+/// displacements. Switching on thinness alone was measured worse: on a 4 %-thick ellipsoid the
+/// normal column is real (the bend), and regions and edges were lost.
+#[allow(clippy::type_complexity)]
+fn level_field(
+    centres: &[Point3],
+    values: &[Point3],
+    kernel: Kernel,
+    pos: &[Point3],
+    progress: &Progress,
+) -> Result<Option<(Rbf, Vec<Point3>, Vec<Jacobian>, bool)>> {
+    let Ok(field) = Rbf::fit(centres, values, kernel, "fine") else { return Ok(None) };
+    let (disp, gradients) = field.eval_with_gradients(pos, progress)?;
+    if rbf::spread_ratios(centres)[0] >= NEAR_FLAT_CENTRES || !mostly_inside_out(&gradients) {
+        return Ok(Some((field, disp, gradients, false)));
+    }
+    let Ok(flat) = Rbf::fit_in_plane(centres, values, kernel, "fine") else {
+        return Ok(Some((field, disp, gradients, false)));
+    };
+    let (disp, gradients) = flat.eval_with_gradients(pos, progress)?;
+    Ok(Some((flat, disp, gradients, true)))
+}
+
+/// Whether x ↦ x + s(x) has det ≤ 0 at more than half of the points (`gradients`: ∇s there).
+fn mostly_inside_out(gradients: &[Jacobian]) -> bool {
+    let inside_out = gradients.iter().filter(|g| !(det(&super::coarse::plus_identity(**g)) > 0.0)).count();
+    2 * inside_out > gradients.len()
 }
 
 /// The curves' median segment length.
@@ -373,6 +425,55 @@ mod tests {
     fn closest(pos: &[Point3], tris: &[[u32; 3]], pts: &[Point3]) -> Vec<(u32, Point3, f64)> {
         let all: Vec<u32> = (0..pts.len() as u32).collect();
         super::super::insert::feet(pos, tris, pts, &all).unwrap()
+    }
+
+    /// Centres on a gently waved plate (0.02 high on a unit square: 2 % thick) whose displacements
+    /// flatten the wave and push it 1.5× beyond: the best affine part then maps height h to
+    /// −0.5·h, so x ↦ x + s(x) turns space inside out everywhere. The level's field must not (the
+    /// in-plane polynomial); the full affine fit is checked to do so, so the case is the one meant.
+    #[test]
+    fn a_level_on_nearly_flat_centres_does_not_turn_space_inside_out() {
+        let mut centres = Vec::new();
+        let mut values = Vec::new();
+        for i in 0..6 {
+            for j in 0..6 {
+                let (x, y) = (i as f64 / 5.0, j as f64 / 5.0);
+                let h = 0.02 * (7.0 * x + 3.0 * y).sin();
+                centres.push([x, y, h]);
+                values.push([0.01 * y, -0.01 * x, -1.5 * h]);
+            }
+        }
+        assert!(rbf::spread_ratios(&centres)[0] < NEAR_FLAT_CENTRES);
+        let grads = |f: &Rbf| -> Vec<Jacobian> { centres.iter().map(|&c| f.gradient(c)).collect() };
+        let full = Rbf::fit(&centres, &values, Kernel::default(), "test").unwrap();
+        assert!(mostly_inside_out(&grads(&full)), "the full affine fit should invert");
+        let (level, disp, gradients, in_plane) =
+            level_field(&centres, &values, Kernel::default(), &centres, &Progress::new()).unwrap().unwrap();
+        assert!(in_plane);
+        assert!(gradients.iter().all(|g| det(&super::super::coarse::plus_identity(*g)) > 0.0));
+        // Still an interpolant of the displacements.
+        for ((c, v), d) in centres.iter().zip(&values).zip(&disp) {
+            assert!(dist(level.eval(*c), *v) < 1e-9 && dist(*d, *v) < 1e-9);
+        }
+    }
+
+    /// The same plate with displacements that keep the heights' order (h ↦ 1.3·h): the full
+    /// affine fit does not turn space inside out, so the level keeps it.
+    #[test]
+    fn a_level_on_nearly_flat_centres_keeps_a_valid_normal_column() {
+        let mut centres = Vec::new();
+        let mut values = Vec::new();
+        for i in 0..6 {
+            for j in 0..6 {
+                let (x, y) = (i as f64 / 5.0, j as f64 / 5.0);
+                let h = 0.02 * (7.0 * x + 3.0 * y).sin();
+                centres.push([x, y, h]);
+                values.push([0.01 * y, -0.01 * x, 0.3 * h]);
+            }
+        }
+        let (_, _, _, in_plane) =
+            level_field(&centres, &values, Kernel::default(), &centres, &Progress::new()).unwrap().unwrap();
+        assert!(!in_plane);
     }
 
     #[test]

@@ -147,7 +147,7 @@ pub fn mat_mul(a: &Jacobian, b: &Jacobian) -> Jacobian {
     std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
 }
 
-fn det(j: &Jacobian) -> f64 {
+pub(super) fn det(j: &Jacobian) -> f64 {
     cofactor_times(j, [0.0; 3]).1
 }
 
