@@ -187,7 +187,7 @@ pub fn approach(
         }
         // The field, its values and gradients at every vertex (the gradients for the orientation
         // count below and the inside-out check).
-        let Some((field, mut disp, mut gradients, in_plane)) =
+        let Some(LevelField { field, mut disp, mut gradients, in_plane }) =
             level_field(&centres, &values, kernel, pos, progress)?
         else {
             continue;
@@ -258,29 +258,41 @@ const NEAR_FLAT_CENTRES: f64 = 0.1;
 /// derivative comes from the kernel terms and vanishes on the plane, and it still interpolates the
 /// displacements. Switching on thinness alone was measured worse: on a 4 %-thick ellipsoid the
 /// normal column is real (the bend), and regions and edges were lost.
-#[allow(clippy::type_complexity)]
 fn level_field(
     centres: &[Point3],
     values: &[Point3],
     kernel: Kernel,
     pos: &[Point3],
     progress: &Progress,
-) -> Result<Option<(Rbf, Vec<Point3>, Vec<Jacobian>, bool)>> {
+) -> Result<Option<LevelField>> {
     let Ok(field) = Rbf::fit(centres, values, kernel, "fine") else { return Ok(None) };
     let (disp, gradients) = field.eval_with_gradients(pos, progress)?;
-    if rbf::spread_ratios(centres)[0] >= NEAR_FLAT_CENTRES || !mostly_inside_out(&gradients) {
-        return Ok(Some((field, disp, gradients, false)));
+    let full = LevelField { field, disp, gradients, in_plane: false };
+    if rbf::spread_ratios(centres)[0] >= NEAR_FLAT_CENTRES || !mostly_inside_out(&full.gradients) {
+        return Ok(Some(full));
     }
-    let Ok(flat) = Rbf::fit_in_plane(centres, values, kernel, "fine") else {
-        return Ok(Some((field, disp, gradients, false)));
-    };
-    let (disp, gradients) = flat.eval_with_gradients(pos, progress)?;
-    Ok(Some((flat, disp, gradients, true)))
+    let Ok(field) = Rbf::fit_in_plane(centres, values, kernel, "fine") else { return Ok(Some(full)) };
+    let (disp, gradients) = field.eval_with_gradients(pos, progress)?;
+    Ok(Some(LevelField { field, disp, gradients, in_plane: true }))
+}
+
+/// An approach level's field with its displacements and gradients at every vertex.
+struct LevelField {
+    field: Rbf,
+    disp: Vec<Point3>,
+    gradients: Vec<Jacobian>,
+    /// Fitted with the in-plane polynomial ([`level_field`]).
+    in_plane: bool,
 }
 
 /// Whether x ↦ x + s(x) has det ≤ 0 at more than half of the points (`gradients`: ∇s there).
 fn mostly_inside_out(gradients: &[Jacobian]) -> bool {
-    let inside_out = gradients.iter().filter(|g| !(det(&super::coarse::plus_identity(**g)) > 0.0)).count();
+    // A NaN determinant (a non-finite gradient) counts as inside out.
+    let inside_out = gradients
+        .iter()
+        .map(|g| det(&super::coarse::plus_identity(*g)))
+        .filter(|d| *d <= 0.0 || d.is_nan())
+        .count();
     2 * inside_out > gradients.len()
 }
 
@@ -447,7 +459,7 @@ mod tests {
         let grads = |f: &Rbf| -> Vec<Jacobian> { centres.iter().map(|&c| f.gradient(c)).collect() };
         let full = Rbf::fit(&centres, &values, Kernel::default(), "test").unwrap();
         assert!(mostly_inside_out(&grads(&full)), "the full affine fit should invert");
-        let (level, disp, gradients, in_plane) =
+        let LevelField { field: level, disp, gradients, in_plane } =
             level_field(&centres, &values, Kernel::default(), &centres, &Progress::new()).unwrap().unwrap();
         assert!(in_plane);
         assert!(gradients.iter().all(|g| det(&super::super::coarse::plus_identity(*g)) > 0.0));
@@ -471,9 +483,9 @@ mod tests {
                 values.push([0.01 * y, -0.01 * x, 0.3 * h]);
             }
         }
-        let (_, _, _, in_plane) =
+        let level =
             level_field(&centres, &values, Kernel::default(), &centres, &Progress::new()).unwrap().unwrap();
-        assert!(!in_plane);
+        assert!(!level.in_plane);
     }
 
     #[test]
