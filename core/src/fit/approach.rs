@@ -443,8 +443,9 @@ mod tests {
     /// flatten the wave and push it 1.5× beyond: the best affine part then maps height h to
     /// −0.5·h, so x ↦ x + s(x) turns space inside out everywhere. The level's field must not (the
     /// in-plane polynomial); the full affine fit is checked to do so, so the case is the one meant.
-    #[test]
-    fn a_level_on_nearly_flat_centres_does_not_turn_space_inside_out() {
+    /// A 6 × 6 grid on the unit square lifted by h = 0.02·sin(7x + 3y), each centre displaced by a
+    /// small in-plane turn and `lift` · h along z.
+    fn waved_plate(lift: f64) -> (Vec<Point3>, Vec<Point3>) {
         let mut centres = Vec::new();
         let mut values = Vec::new();
         for i in 0..6 {
@@ -452,9 +453,15 @@ mod tests {
                 let (x, y) = (i as f64 / 5.0, j as f64 / 5.0);
                 let h = 0.02 * (7.0 * x + 3.0 * y).sin();
                 centres.push([x, y, h]);
-                values.push([0.01 * y, -0.01 * x, -1.5 * h]);
+                values.push([0.01 * y, -0.01 * x, lift * h]);
             }
         }
+        (centres, values)
+    }
+
+    #[test]
+    fn a_level_on_nearly_flat_centres_does_not_turn_space_inside_out() {
+        let (centres, values) = waved_plate(-1.5);
         assert!(rbf::spread_ratios(&centres)[0] < NEAR_FLAT_CENTRES);
         let grads = |f: &Rbf| -> Vec<Jacobian> { centres.iter().map(|&c| f.gradient(c)).collect() };
         let full = Rbf::fit(&centres, &values, Kernel::default(), "test").unwrap();
@@ -473,16 +480,7 @@ mod tests {
     /// affine fit does not turn space inside out, so the level keeps it.
     #[test]
     fn a_level_on_nearly_flat_centres_keeps_a_valid_normal_column() {
-        let mut centres = Vec::new();
-        let mut values = Vec::new();
-        for i in 0..6 {
-            for j in 0..6 {
-                let (x, y) = (i as f64 / 5.0, j as f64 / 5.0);
-                let h = 0.02 * (7.0 * x + 3.0 * y).sin();
-                centres.push([x, y, h]);
-                values.push([0.01 * y, -0.01 * x, 0.3 * h]);
-            }
-        }
+        let (centres, values) = waved_plate(0.3);
         let level =
             level_field(&centres, &values, Kernel::default(), &centres, &Progress::new()).unwrap().unwrap();
         assert!(!level.in_plane);
