@@ -552,10 +552,7 @@ impl Orientation {
         if !open.is_empty() {
             let exact = self.exact_at(open.iter().flat_map(|t| t.iter().copied()));
             for t in open {
-                let d = self.decide(pos, t, |v| exact(v));
-                // Without a replay (none is lost in the fit) the approximate sign decides.
-                let d = if d == Decision::Open { self.decide(pos, t, |v| (stored(v).0, 0.0)) } else { d };
-                against += (d == Decision::Against) as usize;
+                against += self.settle_open(pos, t, &exact) as usize;
             }
         }
         against
@@ -569,15 +566,18 @@ impl Orientation {
         match self.decide(pos, t, stored) {
             Decision::Against => true,
             Decision::With => false,
-            Decision::Open => {
-                let exact = self.exact_at(t.iter().copied());
-                let d = match self.decide(pos, t, |v| exact(v)) {
-                    Decision::Open => self.decide(pos, t, |v| (stored(v).0, 0.0)),
-                    d => d,
-                };
-                d == Decision::Against
-            }
+            Decision::Open => self.settle_open(pos, t, &self.exact_at(t.iter().copied())),
         }
+    }
+
+    /// A face the stored bounds left open, decided with `exact` Jacobians; still open (without a
+    /// replay; none is lost in the fit), the approximate sign decides. Whether it is against.
+    fn settle_open(&self, pos: &[Point3], t: &[u32; 3], exact: &impl Fn(u32) -> (Jacobian, f64)) -> bool {
+        let d = match self.decide(pos, t, exact) {
+            Decision::Open => self.decide(pos, t, |v| (self.jacobians[v as usize], 0.0)),
+            d => d,
+        };
+        d == Decision::Against
     }
 
     /// The count's reference direction of face `t` (stored Jacobians, no bound): where a face

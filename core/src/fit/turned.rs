@@ -236,8 +236,7 @@ fn note(stats: &mut TurnedStats, v: Verdict) {
     }
 }
 
-/// Tally of `faces` (triangles with their normals' neighbours across each edge given by
-/// `neighbours`): each pair counted once.
+/// Tally of `faces` and of the adjacent face pairs `pairs` (their normals; each pair once).
 fn tally(pos: &[Point3], counted: &impl Counted, faces: &[[u32; 3]], pairs: &[(Point3, Point3)]) -> Tally {
     let p = |v: u32| pos[v as usize];
     let mut t = Tally { counted: 0, folds: 0, min_angle: 180.0, degenerate: false };
@@ -273,7 +272,7 @@ fn try_flip(
         }
         let Some(g) = mesh.face_with_edge(b, a) else { continue };
         let Some(&d) = mesh.tris[g as usize].iter().find(|&&v| v != a && v != b) else { continue };
-        if d == c || mesh.has_edge(c, d) {
+        if d == c || mesh.has_edge(c, d) || !replaceable(mesh, [f, g], [[c, a, d], [d, b, c]]) {
             continue;
         }
         let pos = &mesh.pos;
@@ -314,6 +313,22 @@ fn try_flip(
     mesh.remove_face(g);
     let (x, y) = (mesh.add_face(n1).ok()?, mesh.add_face(n2).ok()?);
     Some((gain, vec![x, y]))
+}
+
+/// Whether faces `new` can take the place of faces `old` (both live): no directed edge of `new` is
+/// held by a live face outside `old`. Checked before the old faces are removed, so that
+/// [`TriMesh::add_face`] cannot refuse afterwards and leave the mesh two faces short (a
+/// non-manifold neighbourhood can hold a directed edge twice).
+fn replaceable(mesh: &TriMesh, old: [u32; 2], new: [[u32; 3]; 2]) -> bool {
+    new.iter().all(|t| {
+        (0..3).all(|k| {
+            let (x, y) = (t[k], t[(k + 1) % 3]);
+            mesh.faces_of(x).iter().all(|&h| {
+                let s = mesh.tris[h as usize];
+                old.contains(&h) || !(0..3).any(|j| s[j] == x && s[(j + 1) % 3] == y)
+            })
+        })
+    })
 }
 
 /// Moves one free corner of counted face `f` (towards its ring's mean in the count's tangent
