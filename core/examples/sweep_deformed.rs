@@ -97,8 +97,8 @@ fn main() {
                         let dev = surface.max_distance(m);
                         if std::env::var("SWEEP_DETAIL").is_ok() {
                             eprintln!(
-                                "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}\n  stages {}",
-                                r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"], r["stages"]
+                                "  alignment {}\n  untangle {}\n  cleanup {}\n  retriangulation {}\n  folds {}\n  stages {}\n  turned_faces {}",
+                                r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"], r["stages"], r["turned_faces"]
                             );
                         }
                         if std::env::var("SWEEP_ORDER").is_ok() {

@@ -158,6 +158,7 @@ fn main() {
                     );
                     eprintln!("  stages {}; fine {}", r["stages"], r["fine"]);
                     eprintln!("  zero-area faces {}", r["zero_area_faces"]);
+                    eprintln!("  turned_faces {}", r["turned_faces"]);
                     // Truths where they apply: the template itself (cases "vs own sections" with
                     // alignment none), the direction from the curves' centroid (star-shaped truths:
                     // spheres, ellipsoids about their centre).

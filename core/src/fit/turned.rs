@@ -110,9 +110,37 @@ pub struct TurnedStats {
     /// floor (not made).
     pub refused_floor: usize,
     pub min_angle_floor_deg: f64,
+    /// Why each face still counted was left ([`Left`]).
+    pub left_why: Left,
     /// Where moved vertices went, one batch per move ([`uvs::apply_batches`]).
     #[serde(skip)]
     pub uv_batches: Vec<Vec<UvMove>>,
+}
+
+/// Why the faces still counted after the pass were left, by their last attempt (editable faces
+/// only: `left = skipped_inverted_by_maps + no_edit + fold + floor + no_gain`).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Left {
+    /// No edit to try: every edge locked, on the boundary or not flippable (its flip would make
+    /// an existing edge or a repeated face), and no free corner.
+    pub no_edit: usize,
+    /// Some edit would have lowered the count but added a folded edge (and none was accepted).
+    pub fold: usize,
+    /// Some edit would have lowered the count but made a face degenerate or thinner than the
+    /// floor (and none added a fold).
+    pub floor: usize,
+    /// Every edit tried left the count where it acts as high as before.
+    pub no_gain: usize,
+    /// Of all the above: faces whose three corners are fixed (curve vertices, the boundary).
+    pub all_corners_fixed: usize,
+}
+
+/// What one attempt on a face met: the edits tried and the refusals among them.
+#[derive(Debug, Clone, Copy, Default)]
+struct Attempt {
+    candidates: usize,
+    fold: bool,
+    floor: bool,
 }
 
 /// Why an edit was not made.
@@ -142,6 +170,8 @@ pub fn repair_counted(
     let mut left = bad.len();
     bad.retain(|&f| counted.editable(mesh.tris[f as usize]));
     stats.skipped_inverted_by_maps = stats.counted_before - bad.len();
+    // The last attempt on each face (why a face still counted at the end was left).
+    let mut last: std::collections::HashMap<u32, Attempt> = std::collections::HashMap::new();
     for _ in 0..PASSES {
         let mut next = Vec::new();
         let mut changed = false;
@@ -151,13 +181,16 @@ pub fn repair_counted(
                 continue;
             }
             stats.tried += 1;
-            let gain = match try_flip(mesh, counted, locked, f, &mut stats) {
+            let mut attempt = Attempt::default();
+            let gain = match try_flip(mesh, counted, locked, f, &mut stats, &mut attempt) {
                 Some(g) => {
                     stats.edge_flips += 1;
                     Some(g)
                 }
-                None => try_move(mesh, counted, fixed, f, &mut stats).inspect(|_| stats.vertex_moves += 1),
+                None => try_move(mesh, counted, fixed, f, &mut stats, &mut attempt)
+                    .inspect(|_| stats.vertex_moves += 1),
             };
+            last.insert(f, attempt);
             match gain {
                 Some((g, touched)) => {
                     left -= g;
@@ -176,6 +209,12 @@ pub fn repair_counted(
         bad = next;
         if !changed {
             break;
+        }
+    }
+    for f in bad {
+        if counted.against(&mesh.pos, mesh.tris[f as usize]) {
+            let attempt = last.get(&f).copied().unwrap_or_default();
+            classify(mesh, fixed, f, attempt, &mut stats.left_why);
         }
     }
     stats.left = left;
@@ -228,11 +267,35 @@ fn judge(before: &Tally, after: &Tally) -> Verdict {
     }
 }
 
-fn note(stats: &mut TurnedStats, v: Verdict) {
+fn note(stats: &mut TurnedStats, attempt: &mut Attempt, v: Verdict) {
+    attempt.candidates += 1;
     match v {
-        Verdict::Fold => stats.refused_fold += 1,
-        Verdict::Floor => stats.refused_floor += 1,
+        Verdict::Fold => {
+            stats.refused_fold += 1;
+            attempt.fold = true;
+        }
+        Verdict::Floor => {
+            stats.refused_floor += 1;
+            attempt.floor = true;
+        }
         Verdict::Accept | Verdict::NoGain => {}
+    }
+}
+
+/// Adds the left face `f` to `why` by its last attempt.
+fn classify(mesh: &TriMesh, fixed: &[bool], f: u32, attempt: Attempt, why: &mut Left) {
+    if attempt.fold {
+        why.fold += 1;
+    } else if attempt.floor {
+        why.floor += 1;
+    } else if attempt.candidates == 0 {
+        why.no_edit += 1;
+    } else {
+        why.no_gain += 1;
+    }
+    let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(true) || mesh.is_boundary_vertex(v);
+    if mesh.tris[f as usize].iter().all(|&v| is_fixed(v)) {
+        why.all_corners_fixed += 1;
     }
 }
 
@@ -262,6 +325,7 @@ fn try_flip(
     locked: &EdgeSet,
     f: u32,
     stats: &mut TurnedStats,
+    attempt: &mut Attempt,
 ) -> Option<(usize, Vec<u32>)> {
     let t = mesh.tris[f as usize];
     let mut best: Option<(usize, f64, u32, [u32; 3], [u32; 3])> = None;
@@ -299,7 +363,7 @@ fn try_flip(
         let before = tally(pos, counted, &[t, mesh.tris[g as usize]], &before_pairs);
         let after = tally(pos, counted, &[n1, n2], &after_pairs);
         let verdict = judge(&before, &after);
-        note(stats, verdict);
+        note(stats, attempt, verdict);
         if verdict != Verdict::Accept {
             continue;
         }
@@ -340,6 +404,7 @@ fn try_move(
     fixed: &[bool],
     f: u32,
     stats: &mut TurnedStats,
+    attempt: &mut Attempt,
 ) -> Option<(usize, Vec<u32>)> {
     let t = mesh.tris[f as usize];
     for v in t {
@@ -401,7 +466,7 @@ fn try_move(
                     stats.uv_batches.push(uv.into_iter().collect());
                     return Some((before.counted - after.counted, star));
                 }
-                note(stats, verdict);
+                note(stats, attempt, verdict);
             }
         }
     }

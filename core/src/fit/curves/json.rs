@@ -9,11 +9,13 @@ use crate::mesh::Mesh;
 /// endpoints are joined later, like those of any other curve input.
 pub fn polylines_from_json(bytes: &[u8]) -> Option<Result<Mesh>> {
     let text = std::str::from_utf8(bytes).ok()?.trim_start();
-    if !text.starts_with('{') || !text.contains("\"polylines\"") {
+    if !text.starts_with('{') || text.contains("\"asset\"") && !text.contains("\"polylines\"") {
         return None;
     }
     let doc: serde_json::Value = match serde_json::from_str(text) {
         Ok(v) => v,
+        // Not even JSON and no "polylines" key: maybe a truncated glTF; the mesh readers say why.
+        Err(_) if !text.contains("\"polylines\"") => return None,
         Err(e) => {
             return Some(Err(Error::malformed(
                 "json",
@@ -22,8 +24,17 @@ pub fn polylines_from_json(bytes: &[u8]) -> Option<Result<Mesh>> {
             )))
         }
     };
-    let lines = doc.get("polylines")?;
-    Some(parse_polylines(lines))
+    match doc.get("polylines") {
+        Some(lines) => Some(parse_polylines(lines)),
+        // A JSON object that is neither glTF (no "asset") nor a curves document: the mesh readers
+        // would only say that no format matches, so say what a curves document needs.
+        None if doc.is_object() => Some(Err(Error::malformed(
+            "json",
+            crate::error::Location::Gltf("polylines".into()),
+            "a curves JSON document is {\"polylines\": [[[x, y, z], …], …]}; this object has no \"polylines\" key",
+        ))),
+        None => None,
+    }
 }
 
 fn parse_polylines(lines: &serde_json::Value) -> Result<Mesh> {
@@ -93,5 +104,9 @@ mod json_tests {
         assert!(e.to_string().contains("polylines[0]"), "{e}");
         assert!(polylines_from_json(b"v 0 0 0\n").is_none());
         assert!(polylines_from_json(br#"{"asset": {"version": "2.0"}}"#).is_none());
+        // An object with neither key names the key it lacks (it was "matches no format").
+        let e = polylines_from_json(br#"{"lines": [[[0,0,0],[1,0,0]]]}"#).unwrap().unwrap_err();
+        assert!(e.to_string().contains("no \"polylines\" key"), "{e}");
+        assert!(polylines_from_json(br#"{"lines": "#).is_none());
     }
 }

@@ -81,6 +81,10 @@ fn a_flip_is_made_unless_it_folds_a_neighbour() {
     let s = repair_counted(&mut mesh, &up, &[true; 6], &locked, &Progress::new()).unwrap();
     assert_eq!((s.counted_before, s.edge_flips, s.vertex_moves, s.left), (3, 0, 0, 3), "{s:?}");
     assert!(s.refused_fold >= 1, "{s:?}");
+    // Why, by hand: (0, 2, 3)'s only flip folds (the fold above); (3, 2, 4) and (0, 3, 5) have one
+    // locked edge and two boundary edges, and every corner fixed: no edit to try.
+    let w = &s.left_why;
+    assert_eq!((w.fold, w.no_edit, w.floor, w.no_gain, w.all_corners_fixed), (1, 2, 0, 0, 3), "{s:?}");
     assert!(mesh.has_edge(0, 2) && !mesh.has_edge(1, 3));
     let n = triangle_cross(mesh.pos[0], mesh.pos[2], mesh.pos[3]);
     assert!(n[2] < 0.0);
