@@ -101,6 +101,15 @@ fn main() {
                                 r["alignment"], r["untangle"], r["cleanup"], r["retriangulation"], r["folds"], r["stages"], r["turned_faces"]
                             );
                         }
+                        if std::env::var("SWEEP_ORDER").is_ok() {
+                            let i = &r["fine"]["insertion"];
+                            println!(
+                                "  order {label}: closest {} walked {} stretched {} before the approach {} stretched {}",
+                                i["out_of_order_closest"], i["out_of_order"], i["stretched"],
+                                r["fine"]["approach"]["out_of_order_before"],
+                                r["fine"]["approach"]["stretched_before"]
+                            );
+                        }
                         if std::env::var("SWEEP_FOLDS").is_ok() {
                             print_folds(m);
                         }

@@ -50,6 +50,10 @@ pub struct ApproachReport {
     /// Levels whose field was fitted again with the in-plane polynomial, because on their nearly
     /// flat centres the full affine part turned space inside out ([`level_field`]).
     pub in_plane_fields: usize,
+    /// Segments whose closest feet on the surface before the approach are out of the curve's
+    /// order or stretched ([`super::insert::order`]), as the insertion counts them after it.
+    pub out_of_order_before: usize,
+    pub stretched_before: usize,
 }
 
 /// Field refinement gate ([`super::field_refine`]): a level's sample missed by more than this
@@ -127,6 +131,11 @@ pub fn approach(
         }
     };
     let mut unmoved = Some(feet_of(pos, tris, &vf, &all)?);
+    if let Some(f) = &unmoved {
+        let points: Vec<Point3> = f.iter().map(|f| f.1).collect();
+        report.out_of_order_before = super::insert::order::out_of_order_segments(net, &points);
+        report.stretched_before = super::insert::order::stretched_segments(net, &points);
+    }
     if unmoved.iter().flatten().any(|f| f.2 > max_distance) {
         return Ok(report);
     }

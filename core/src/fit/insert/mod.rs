@@ -62,6 +62,8 @@ pub struct InsertStats {
     /// and with the walked feet used.
     pub out_of_order_closest: usize,
     pub out_of_order: usize,
+    /// Segments whose feet are more than [`order::MAX_STRETCH`] × the segment apart.
+    pub stretched: usize,
     /// Distance from each curve vertex to its template vertex before the fine deformation.
     pub distance_max: f64,
     pub distance_mean: f64,
@@ -123,6 +125,7 @@ pub fn insert_curve_points(
     }
     let spread = pileup::spread_piled_feet(pos, tris, &vf, &net.points, &mut feet, &keep);
     let out_of_order = order::out_of_order_segments(net, &foot_points(&feet));
+    let stretched = order::stretched_segments(net, &foot_points(&feet));
     let spacing = shortest_segments(net);
     let mut queue: Vec<u32> = (0..n as u32).filter(|&p| vop[p as usize] == u32::MAX).collect();
     queue.sort_by(|&a, &b| {
@@ -141,6 +144,7 @@ pub fn insert_curve_points(
     ins.stats.spread_feet = spread;
     ins.stats.out_of_order_closest = out_of_order_closest;
     ins.stats.out_of_order = out_of_order;
+    ins.stats.stretched = stretched;
     let d: Vec<f64> = (0..n).map(|p| dist(net.points[p], ins.mesh.pos[vop[p] as usize])).collect();
     ins.stats.distance_max = d.iter().cloned().fold(0.0, f64::max);
     ins.stats.distance_mean = d.iter().sum::<f64>() / n.max(1) as f64;

@@ -35,6 +35,26 @@ pub fn out_of_order_segments(net: &CurveNetwork, foot: &[Point3]) -> usize {
         .count()
 }
 
+/// Feet more than this many times farther apart than their curve points count as stretched.
+pub const MAX_STRETCH: f64 = 2.0;
+
+/// Segments of the network whose feet are more than [`MAX_STRETCH`] × the segment apart: on the
+/// concave side of a surface of curvature radius R, a curve d off has its feet spread by
+/// R / (R − d) (over 2 once d > R / 2); feet that jump across a crease or to another sheet spread
+/// too. The fine RBF squeezes the faces between such feet onto the segment. A sign measured in
+/// session 18 (docs/benchmarks.md, seps18): rows that end at the bar have 1–2 such segments,
+/// the others 9 on average.
+pub fn stretched_segments(net: &CurveNetwork, foot: &[Point3]) -> usize {
+    net.segments
+        .iter()
+        .filter(|s| {
+            let (p, q) = (s[0] as usize, s[1] as usize);
+            crate::geometry::dist(foot[p], foot[q])
+                > MAX_STRETCH * crate::geometry::dist(net.points[p], net.points[q])
+        })
+        .count()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -64,5 +84,28 @@ mod tests {
         foot[3] = foot[2];
         assert!(!in_order(pts[2], pts[3], foot[2], foot[3]));
         assert_eq!(out_of_order_segments(&n, &foot), 1);
+    }
+
+    #[test]
+    fn feet_spread_by_a_concave_arc_are_stretched_at_more_than_half_the_radius() {
+        // Curve points on an arc of radius 1, inside a concentric tube of radius r: their closest
+        // points are on the tube's arc of radius r, straight out, so the feet are r × the points'
+        // spacing apart (d = r − 1 off a surface of radius R = r: spread R / (R − d) = r, over 2
+        // once d > R / 2). Hand count: r = 1.9 → none stretched, r = 2.1 → all 7 segments.
+        let arc = |r: f64| -> Vec<Point3> {
+            (0..8)
+                .map(|i| {
+                    let a = 0.1 * i as f64;
+                    [r * a.cos(), r * a.sin(), 0.0]
+                })
+                .collect()
+        };
+        let n = net(arc(1.0));
+        assert_eq!(stretched_segments(&n, &arc(1.9)), 0);
+        assert_eq!(stretched_segments(&n, &arc(2.1)), 7);
+        // One foot jumped away (to another sheet 0.5 below): its two segments, and only they.
+        let mut foot = arc(1.0);
+        foot[3][2] -= 0.5;
+        assert_eq!(stretched_segments(&n, &foot), 2);
     }
 }

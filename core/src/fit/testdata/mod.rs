@@ -18,6 +18,7 @@ pub mod checks;
 pub mod curves;
 pub mod files;
 pub mod heldout;
+pub mod regions;
 pub mod sections;
 pub mod templates;
 
@@ -25,5 +26,6 @@ pub use checks::*;
 pub use curves::*;
 pub use files::*;
 pub use heldout::*;
+pub use regions::*;
 pub use sections::*;
 pub use templates::*;

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use crate::geometry::{add, dot, scale, sub, Aabb};
 use crate::mesh::{Mesh, Point3};
-use crate::shapes::{fan_triangles, subdivide_midpoint};
+use crate::shapes::fan_triangles;
 
 /// The three principal-plane sections of the ellipsoid x²/a² + y²/b² + z²/c² = 1, each sampled at
 /// `per_quadrant` points per quarter so that the six axis points are shared: 6 feature points of
@@ -248,10 +248,11 @@ pub fn crossing_pairs(
         .collect()
 }
 
-/// Regions a set of planes cuts a surface into (the truth for section networks), counted on a
-/// 4×-subdivided copy (see [`plane_regions`]).
+/// Regions a set of planes cuts a surface into (the truth for section networks), counted exactly
+/// ([`super::exact_plane_regions`]; until session 18 it was [`plane_regions`] on a 4×-subdivided
+/// copy, which moved by up to 7 with the subdivision level on the shared meshes).
 pub fn section_regions(m: &Mesh, planes: &[(Point3, f64)]) -> usize {
-    plane_regions(&subdivide_midpoint(m, 2), planes)
+    super::exact_plane_regions(m, planes)
 }
 
 /// Regions of `fine` minus the planes: faces grouped by the side of every plane, connected through
