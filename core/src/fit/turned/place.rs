@@ -23,7 +23,7 @@ fn min_angle_2d(ring: &[([f64; 2], [f64; 2])], m: [f64; 2]) -> Option<f64> {
     let mut worst = f64::INFINITY;
     for &(x, y) in ring {
         let c = (x[0] - m[0]) * (y[1] - m[1]) - (x[1] - m[1]) * (y[0] - m[0]);
-        if !(c > 0.0) {
+        if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let p = |q: [f64; 2]| [q[0], q[1], 0.0];
@@ -63,16 +63,9 @@ pub(super) fn best_centre(ring: &[(Point3, Point3)], n: Point3, starts: &[Point3
     let (mut p, mut a) = best?;
     let size = ring.iter().map(|&(x, y)| crate::geometry::dist(x, y)).fold(0.0, f64::max);
     let mut h = 0.25 * size;
-    const DIRS: [[f64; 2]; 8] = [
-        [1.0, 0.0],
-        [-1.0, 0.0],
-        [0.0, 1.0],
-        [0.0, -1.0],
-        [0.7071067811865476, 0.7071067811865476],
-        [-0.7071067811865476, 0.7071067811865476],
-        [0.7071067811865476, -0.7071067811865476],
-        [-0.7071067811865476, -0.7071067811865476],
-    ];
+    const D: f64 = std::f64::consts::FRAC_1_SQRT_2;
+    const DIRS: [[f64; 2]; 8] =
+        [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0], [D, D], [-D, D], [D, -D], [-D, -D]];
     let (mut halvings, mut steps) = (0, 0);
     while halvings < HALVINGS && steps < MAX_STEPS {
         steps += 1;
