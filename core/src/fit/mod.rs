@@ -12,7 +12,7 @@
 //! 5. `partition`: faces labelled by region ([`partition`]).
 //! 6. `smooth`: tangential flows with the curves fixed ([`smooth`]).
 //! 7. `turned_faces`: the faces the report's `flipped_faces` counts, repaired by local edits that
-//!    add no fold ([`turned`]).
+//!    add no fold (edge flips, vertex moves, edge splits: [`turned`]).
 //!
 //! The output mesh has one face group per region and carries the curves as vertex chains.
 //!
@@ -477,14 +477,33 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let turned = stages.run(progress, "turned_faces", || {
         let mut fixed_now = fixed.clone();
         fixed_now.resize(mesh.pos.len(), true);
-        turned::repair_counted(&mut mesh, &orientation, &fixed_now, &curve_edges, progress)
+        turned::repair_counted(
+            &mut mesh,
+            &mut orientation,
+            &reference_normals,
+            &fixed_now,
+            &curve_edges,
+            progress,
+        )
     })?;
-    if turned.vertex_moves > 0 {
+    // Vertices its splits added (the orientation has them already): free, after every other in
+    // each per-vertex array, their reference normal their edge's ends' sum.
+    for a in &turned.added {
+        parents.push(*a);
+        realised.on_curve.push(false);
+        let n = add(
+            scale(reference_normals[a[0].0 as usize], a[0].1),
+            scale(reference_normals[a[1].0 as usize], a[1].1),
+        );
+        reference_normals.push(crate::geometry::normalize(n));
+    }
+    mesh.check_growth("turned_faces")?;
+    if turned.vertex_moves + turned.edge_splits > 0 {
         out_pos.clone_from(&mesh.pos);
     }
-    if turned.edge_flips > 0 {
-        // Flipped edges are never curve edges: the regions are the same, relabelled for the new
-        // face list.
+    if turned.edge_flips + turned.edge_splits > 0 {
+        // Flipped and split edges are never curve edges: the regions are the same, relabelled for
+        // the new face list.
         out_tris = mesh.live_triangles();
         (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
         if keep_groups {

@@ -151,6 +151,17 @@ impl TriMesh {
         (self.pos.len() - 1) as u32
     }
 
+    /// Removes the last vertex when no face uses it (a vertex added to judge an edit that was not
+    /// made); false otherwise.
+    pub fn pop_vertex(&mut self) -> bool {
+        if !self.vfaces.last().is_some_and(|f| f.is_empty()) {
+            return false;
+        }
+        self.vfaces.pop();
+        self.pos.pop();
+        true
+    }
+
     /// Adds a face; Err(()) if one of its directed edges is already taken.
     pub fn add_face(&mut self, t: [u32; 3]) -> std::result::Result<u32, ()> {
         for k in 0..3 {

@@ -1,6 +1,9 @@
 use super::*;
 use crate::geometry::triangle_cross;
 
+/// The fine surface's normals where it is the plane z = 0 seen from above.
+const UP: [Point3; 8] = [[0.0, 0.0, 1.0]; 8];
+
 /// A regular hexagon (radius 1, plane z = 0, counter-clockwise) around centre vertex 6.
 fn hexagon_fan(centre: Point3) -> (Vec<Point3>, Vec<[u32; 3]>) {
     let mut pos: Vec<Point3> = (0..6)
@@ -27,9 +30,10 @@ fn a_face_turned_by_a_free_corner_is_turned_back_by_moving_it() {
     let (pos, tris) = hexagon_fan([0.9, 0.5, 0.0]);
     let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
     assert_eq!(up_faces(&mesh), 5);
-    let reference = vec![[0.0, 0.0, 1.0]; 7];
+    let mut reference = vec![[0.0, 0.0, 1.0]; 7];
     let fixed = [true, true, true, true, true, true, false];
-    let s = repair_counted(&mut mesh, &reference, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    let s = repair_counted(&mut mesh, &mut reference, &UP, &fixed, &EdgeSet::default(), &Progress::new())
+        .unwrap();
     assert_eq!((s.counted_before, s.fixed, s.left, s.vertex_moves, s.edge_flips), (1, 1, 0, 1, 0), "{s:?}");
     assert_eq!(up_faces(&mesh), 6);
     assert_eq!(&mesh.pos[..6], &pos[..6]);
@@ -43,12 +47,13 @@ fn a_face_turned_by_a_free_corner_is_turned_back_by_moving_it() {
 #[test]
 fn the_reports_count_is_what_the_pass_lowers() {
     let (template, tris) = hexagon_fan([0.0, 0.0, 0.0]);
-    let orientation = Orientation::new(&template, &tris);
+    let mut orientation = Orientation::new(&template, &tris);
     let (pos, _) = hexagon_fan([0.9, 0.5, 0.0]);
     let mut mesh = TriMesh::new(pos, tris.clone()).unwrap();
     assert_eq!(orientation.faces_against(&mesh.pos, &tris), 1);
     let fixed = [true, true, true, true, true, true, false];
-    let s = repair_counted(&mut mesh, &orientation, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    let s = repair_counted(&mut mesh, &mut orientation, &UP, &fixed, &EdgeSet::default(), &Progress::new())
+        .unwrap();
     assert_eq!((s.counted_before, s.left), (1, 0), "{s:?}");
     assert_eq!(orientation.faces_against(&mesh.pos, &mesh.live_triangles()), 0);
 }
@@ -61,9 +66,10 @@ fn the_reports_count_is_what_the_pass_lowers() {
 #[test]
 fn a_flip_is_made_unless_it_folds_a_neighbour() {
     let quad = vec![[0.0, 0.0, 0.0], [1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, -0.3, 0.0]];
-    let up = vec![[0.0, 0.0, 1.0]; 6];
+    let mut up = vec![[0.0, 0.0, 1.0]; 6];
     let mut mesh = TriMesh::new(quad.clone(), vec![[0, 1, 2], [0, 2, 3]]).unwrap();
-    let s = repair_counted(&mut mesh, &up, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
+    let s =
+        repair_counted(&mut mesh, &mut up, &UP, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
     assert_eq!((s.counted_before, s.edge_flips, s.left, s.refused_fold), (1, 1, 0, 0), "{s:?}");
     assert!(mesh.has_edge(1, 3) && !mesh.has_edge(0, 2));
     assert_eq!(up_faces(&mesh), 2);
@@ -78,7 +84,7 @@ fn a_flip_is_made_unless_it_folds_a_neighbour() {
     let mut locked = EdgeSet::default();
     locked.insert((2, 3));
     locked.insert((0, 3));
-    let s = repair_counted(&mut mesh, &up, &[true; 6], &locked, &Progress::new()).unwrap();
+    let s = repair_counted(&mut mesh, &mut up, &UP, &[true; 6], &locked, &Progress::new()).unwrap();
     assert_eq!((s.counted_before, s.edge_flips, s.vertex_moves, s.left), (3, 0, 0, 3), "{s:?}");
     assert!(s.refused_fold >= 1, "{s:?}");
     // Why, by hand: (0, 2, 3)'s only flip folds (the fold above); (3, 2, 4) and (0, 3, 5) have one
@@ -103,8 +109,91 @@ fn faces_where_the_maps_invert_space_are_left_and_reported() {
     let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
     assert_eq!(orientation.faces_against(&mesh.pos, &tris), 5);
     let fixed = [true, true, true, true, true, true, false];
-    let s = repair_counted(&mut mesh, &orientation, &fixed, &EdgeSet::default(), &Progress::new()).unwrap();
+    let s = repair_counted(&mut mesh, &mut orientation, &UP, &fixed, &EdgeSet::default(), &Progress::new())
+        .unwrap();
     assert_eq!((s.counted_before, s.skipped_inverted_by_maps, s.tried, s.left), (5, 5, 0, 5), "{s:?}");
     assert_eq!(mesh.pos, pos);
     assert_eq!(mesh.live_triangles(), tris);
+}
+
+/// a = (0, 0), b = (1, 0), c = (0.2, −0.1), d = (1.2, −0.9), all fixed: (a, b, c) points down
+/// (cross −0.1), (b, a, d) up (cross 0.9). Flipping a–b gives (c, a, d) and (d, b, c), both up,
+/// but (c, a, d) has a 1.79° corner at d (by hand: 10.30° at a, 167.91° at c), below the 2°
+/// floor and the 7.13° (at b) of the faces it replaces: refused, and no corner may move. A new
+/// vertex on a–b moved inside the quad c, a, d, b makes four faces up whose smallest angle can be
+/// above 3° (a grid search by hand: 3.22° near (0.50, −0.31)).
+fn sliver_quad() -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let pos = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.2, -0.1, 0.0], [1.2, -0.9, 0.0]];
+    (pos, vec![[0, 1, 2], [1, 0, 3]])
+}
+
+fn min_angle_of(mesh: &TriMesh) -> f64 {
+    mesh.alive_faces()
+        .map(|f| {
+            let t = mesh.tris[f as usize];
+            min_angle_deg(mesh.pos[t[0] as usize], mesh.pos[t[1] as usize], mesh.pos[t[2] as usize])
+        })
+        .fold(180.0, f64::min)
+}
+
+#[test]
+fn a_face_whose_flip_makes_a_sliver_is_split_instead() {
+    let (pos, tris) = sliver_quad();
+    let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
+    assert_eq!(up_faces(&mesh), 1);
+    let mut up = vec![[0.0, 0.0, 1.0]; 4];
+    let s =
+        repair_counted(&mut mesh, &mut up, &UP, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!(
+        (s.counted_before, s.edge_flips, s.vertex_moves, s.edge_splits, s.left),
+        (1, 0, 0, 1, 0),
+        "{s:?}"
+    );
+    assert!(s.refused_floor >= 1, "{s:?}");
+    assert_eq!((mesh.pos.len(), mesh.live_faces(), up_faces(&mesh)), (5, 4, 4));
+    assert_eq!(&mesh.pos[..4], &pos[..]);
+    // The quad's outline is kept, a–b is gone, the new vertex is joined to all four corners.
+    for (x, y) in [(2, 0), (1, 2), (3, 1), (0, 3), (4, 0), (4, 1), (4, 2), (4, 3)] {
+        assert!(mesh.face_with_edge(x, y).is_some(), "edge {x}→{y}");
+    }
+    assert!(!mesh.has_edge(0, 1));
+    assert!(min_angle_of(&mesh) >= MIN_ANGLE_FLOOR_DEG, "{}", min_angle_of(&mesh));
+    assert_eq!(s.added, vec![[(0, 0.5), (1, 0.5), (0, 0.0)]]);
+    assert_eq!(up.len(), 5);
+    assert_eq!(s.uv_batches.len(), 1);
+    assert_eq!(s.uv_batches[0][0].vertex, 4);
+}
+
+/// The same under the report's own count: the template is the quad with c above a–b, (0.2, 0.1),
+/// all faces up; identity maps. The output's c below a–b is counted (1), the split leaves 0, and
+/// the count knows the new vertex (its maps blended from a and b).
+#[test]
+fn the_reports_count_follows_a_split() {
+    let (pos, tris) = sliver_quad();
+    let mut template = pos.clone();
+    template[2] = [0.2, 0.1, 0.0];
+    let mut orientation = Orientation::new(&template, &tris);
+    let mut mesh = TriMesh::new(pos, tris.clone()).unwrap();
+    assert_eq!(orientation.faces_against(&mesh.pos, &tris), 1);
+    let s =
+        repair_counted(&mut mesh, &mut orientation, &UP, &[true; 4], &EdgeSet::default(), &Progress::new())
+            .unwrap();
+    assert_eq!((s.counted_before, s.edge_splits, s.left), (1, 1, 0), "{s:?}");
+    assert_eq!(orientation.len(), 5);
+    assert_eq!(orientation.faces_against(&mesh.pos, &mesh.live_triangles()), 0);
+}
+
+/// The sliver quad again, but the fine surface says the quad is seen from below (normals −z):
+/// the four faces of the split would all oppose it. The split is refused and the face left.
+#[test]
+fn a_split_that_turns_more_faces_against_the_fine_surface_is_refused() {
+    let (pos, tris) = sliver_quad();
+    let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
+    let mut up = vec![[0.0, 0.0, 1.0]; 4];
+    let down = [[0.0, 0.0, -1.0]; 4];
+    let s =
+        repair_counted(&mut mesh, &mut up, &down, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.edge_splits, s.left), (1, 0, 1), "{s:?}");
+    assert!(s.refused_surface >= 1, "{s:?}");
+    assert_eq!((mesh.live_triangles(), mesh.pos, up.len()), (tris, pos, 4));
 }
