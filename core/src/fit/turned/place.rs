@@ -8,7 +8,8 @@
 //! the plane (halving its step) from the best of a few starting points, keeping every face of the
 //! star turning the right way round.
 
-use crate::geometry::{add, corner_angle, cross, dot, normalize, scale, sub};
+use crate::fit::untangle::RingFrame;
+use crate::geometry::corner_angle;
 use crate::mesh::Point3;
 
 /// Halvings of the search's step.
@@ -38,18 +39,8 @@ fn min_angle_2d(ring: &[([f64; 2], [f64; 2])], m: [f64; 2]) -> Option<f64> {
 /// centre) seen along `n`, lifted to the ring's mean height, from starting points `starts`; None
 /// when no start has every face turning the right way round.
 pub(super) fn best_centre(ring: &[(Point3, Point3)], n: Point3, starts: &[Point3]) -> Option<Point3> {
-    let n = normalize(n);
-    if n == [0.0; 3] || ring.is_empty() {
-        return None;
-    }
-    let o = scale(ring.iter().fold([0.0; 3], |s, e| add(add(s, e.0), e.1)), 0.5 / ring.len() as f64);
-    let t = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-    let u = normalize(cross(n, t));
-    let w = cross(n, u);
-    let flat = |p: Point3| {
-        let d = sub(p, o);
-        [dot(d, u), dot(d, w)]
-    };
+    let frame = RingFrame::new(ring, n)?;
+    let flat = |p: Point3| frame.flat(p);
     let ring2: Vec<([f64; 2], [f64; 2])> = ring.iter().map(|&(x, y)| (flat(x), flat(y))).collect();
     let mut best: Option<([f64; 2], f64)> = None;
     for &s in starts {
@@ -83,5 +74,5 @@ pub(super) fn best_centre(ring: &[(Point3, Point3)], n: Point3, starts: &[Point3
             halvings += 1;
         }
     }
-    Some(add(o, add(scale(u, p[0]), scale(w, p[1]))))
+    Some(frame.lift(p))
 }

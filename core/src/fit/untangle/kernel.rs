@@ -21,20 +21,8 @@ pub(crate) fn kernel_centre(ring_edges: &[(Point3, Point3)], n: Point3) -> Optio
     if ring_edges.is_empty() || ring_edges.len() > MAX_RING {
         return None;
     }
-    // A frame (u, w) of the plane ⊥ n, origin at the ring's mean.
-    let n = normalize(n);
-    if n == [0.0; 3] {
-        return None;
-    }
-    let o =
-        scale(ring_edges.iter().fold([0.0; 3], |s, e| add(add(s, e.0), e.1)), 0.5 / ring_edges.len() as f64);
-    let t = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-    let u = normalize(cross(n, t));
-    let w = cross(n, u);
-    let flat = |p: Point3| {
-        let d = sub(p, o);
-        [dot(d, u), dot(d, w)]
-    };
+    let frame = RingFrame::new(ring_edges, n)?;
+    let flat = |p: Point3| frame.flat(p);
     // Half-plane of edge x → y: cross2(y − x, p − x) ≥ r·|y − x|, i.e. a·p − r ≥ b with a the
     // unit left normal of the edge.
     let mut cons: Vec<([f64; 2], f64)> = Vec::with_capacity(ring_edges.len());
@@ -86,8 +74,42 @@ pub(crate) fn kernel_centre(ring_edges: &[(Point3, Point3)], n: Point3) -> Optio
         }
     }
     let (p, _) = best?;
-    // Height: the ring's mean (the origin) — the plane through the ring along n.
-    Some(add(o, add(scale(u, p[0]), scale(w, p[1]))))
+    Some(frame.lift(p))
+}
+
+/// A frame (u, w) of the plane ⊥ n through the mean of a ring's edge ends: ring positions seen
+/// along n as plane coordinates, and plane points lifted back at the ring's mean height.
+pub(crate) struct RingFrame {
+    o: Point3,
+    u: Point3,
+    w: Point3,
+}
+
+impl RingFrame {
+    /// None for a zero `n` or an empty ring.
+    pub(crate) fn new(ring_edges: &[(Point3, Point3)], n: Point3) -> Option<Self> {
+        let n = normalize(n);
+        if n == [0.0; 3] || ring_edges.is_empty() {
+            return None;
+        }
+        let o = scale(
+            ring_edges.iter().fold([0.0; 3], |s, e| add(add(s, e.0), e.1)),
+            0.5 / ring_edges.len() as f64,
+        );
+        let t = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let u = normalize(cross(n, t));
+        Some(Self { o, u, w: cross(n, u) })
+    }
+
+    pub(crate) fn flat(&self, p: Point3) -> [f64; 2] {
+        let d = sub(p, self.o);
+        [dot(d, self.u), dot(d, self.w)]
+    }
+
+    /// The point at plane coordinates `p`, at the ring's mean height along n.
+    pub(crate) fn lift(&self, p: [f64; 2]) -> Point3 {
+        add(self.o, add(scale(self.u, p[0]), scale(self.w, p[1])))
+    }
 }
 
 #[cfg(test)]

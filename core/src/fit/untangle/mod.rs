@@ -31,7 +31,7 @@ mod kernel;
 mod patch;
 
 pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
-pub(crate) use kernel::kernel_centre;
+pub(crate) use kernel::{kernel_centre, RingFrame};
 
 /// A face counts as folded when its normal is within this cosine of perpendicular to the reference
 /// (or beyond): a face standing on its edge, e.g. three consecutive vertices of one planar curve,
