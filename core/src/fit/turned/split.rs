@@ -91,7 +91,7 @@ pub(super) fn try_split(
         for q in targets {
             mesh.pos[m as usize] = q;
             let after = tally(&mesh.pos, &*counted, &new, &normals(&mesh.pos, &after_faces));
-            let mut verdict = judge(&before, &after);
+            let mut verdict = judge(&before, &after, stats.floor_now);
             if verdict == Verdict::Accept && against_surface(&mesh.pos, surface, &new, Some(m_surface)) > 0 {
                 verdict = Verdict::Surface;
             }

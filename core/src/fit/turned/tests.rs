@@ -197,3 +197,40 @@ fn a_split_that_turns_more_faces_against_the_fine_surface_is_refused() {
     assert!(s.refused_surface >= 1, "{s:?}");
     assert_eq!((mesh.live_triangles(), mesh.pos, up.len()), (tris, pos, 4));
 }
+
+/// The sliver quad with every split refused (the fine surface points down, so the split's four
+/// up faces oppose it) and no corner free: the flip's 1.79° corner is below the 2° floor, so the
+/// face is left while the mesh has no thinner face (smallest 7.13°, above the floor: the last
+/// passes do not run). With a thin triangle elsewhere (its base angles atan(0.005 / 0.5) = 0.573°
+/// by hand), the last passes accept the flip: its faces are no thinner than the mesh already was,
+/// and the mesh's smallest angle stays 0.573°.
+#[test]
+fn a_flip_below_the_floor_is_made_when_the_mesh_is_already_thinner() {
+    let down = vec![[0.0, 0.0, -1.0]; 7];
+    let (pos, tris) = sliver_quad();
+    let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
+    let mut up = vec![[0.0, 0.0, 1.0]; 4];
+    let s =
+        repair_counted(&mut mesh, &mut up, &down, &[true; 4], &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.left, s.edge_flips, s.edge_splits), (1, 1, 0, 0), "{s:?}");
+    assert_eq!((s.last_resort_floor_deg, s.fixed_at_last_resort), (None, 0), "{s:?}");
+    assert!(s.refused_floor >= 1 && s.refused_surface >= 1, "{s:?}");
+    assert_eq!(mesh.live_triangles(), tris);
+
+    let mut pos = pos;
+    pos.extend([[5.0, 0.0, 0.0], [6.0, 0.0, 0.0], [5.5, 0.005, 0.0]]);
+    let mut tris = tris;
+    tris.push([4, 5, 6]);
+    let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
+    let thin = min_angle_of(&mesh);
+    assert!((thin - 0.005f64.atan2(0.5).to_degrees()).abs() < 1e-9, "{thin}");
+    let mut up = vec![[0.0, 0.0, 1.0]; 7];
+    let s =
+        repair_counted(&mut mesh, &mut up, &down, &[true; 7], &EdgeSet::default(), &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.left, s.edge_flips, s.fixed_at_last_resort), (1, 0, 1, 1), "{s:?}");
+    assert!((s.last_resort_floor_deg.unwrap() - thin).abs() < 1e-12, "{s:?}");
+    assert_eq!(up_faces(&mesh), 3);
+    assert!(mesh.has_edge(2, 3) && !mesh.has_edge(0, 1));
+    assert!((min_angle_of(&mesh) - thin).abs() < 1e-9, "{}", min_angle_of(&mesh));
+    assert_eq!(mesh.pos, pos);
+}
