@@ -18,8 +18,13 @@
 //! placed inside the quad of the edge's two faces ([`place`]): where the flip's one diagonal makes
 //! a sliver below the floor, four faces around an inner point need not (measured, turned18: the
 //! faces left were mostly refused for the floor or had no gain, two thirds with three fixed
-//! corners). A split must also make no face that opposes the fine surface. Curve vertices never
-//! move and curve edges are never flipped or split, so every chain stays as it is.
+//! corners). A split must also make no face that opposes the fine surface. Faces left at the
+//! 2° floor are tried again at the mesh's own smallest angle (no edit then lowers the output's
+//! `min_angle_deg`), and what no single edit fixes gets the flip-sequence search of
+//! [`super::untangle`] under the same rules (session 19: the faces left were mostly well-shaped
+//! triangles of three fixed corners, 133 of 641 on the first deformed set with one curve edge).
+//! Curve vertices never move and curve edges are never flipped or split, so every chain stays as
+//! it is.
 
 use std::collections::HashMap;
 
@@ -32,8 +37,9 @@ use crate::mesh::Point3;
 
 use super::degenerate::is_zero_area;
 use super::orientation::Orientation;
+use super::reference::Reference;
 use super::trimesh::{EdgeSet, TriMesh};
-use super::untangle::FOLD_ANGLE_DEG;
+use super::untangle::{self, FOLD_ANGLE_DEG};
 use super::uvs::{self, UvMove};
 
 mod place;
@@ -166,6 +172,11 @@ pub struct TurnedStats {
     pub last_resort_floor_deg: Option<f64>,
     /// Counted faces those last passes made uncounted (included in `fixed`).
     pub fixed_at_last_resort: usize,
+    /// Neighbourhoods of counted faces left by the single edits, re-connected by a sequence of up
+    /// to 3 edge flips through worse intermediate states ([`super::untangle`]'s flip search),
+    /// each kept under the single edits' rules; and the flips they made.
+    pub flip_sequences: usize,
+    pub sequence_flips: usize,
     /// The floor the edits are judged by now ([`judge`]).
     #[serde(skip)]
     floor_now: f64,
@@ -230,7 +241,7 @@ enum Verdict {
 /// vertex normals ([`split::against_surface`]), which no face a split makes may oppose.
 pub fn repair_counted(
     mesh: &mut TriMesh,
-    counted: &mut impl Counted,
+    counted: &mut (impl Counted + Reference),
     surface: &[Point3],
     fixed: &[bool],
     locked: &EdgeSet,
@@ -266,14 +277,34 @@ pub fn repair_counted(
             stats.fixed_at_last_resort = before - left;
         }
     }
+    // What no single edit reaches (a face whose corners are all fixed, turned with its
+    // neighbours): sequences of flips, each end state judged as one edit.
+    if !bad.is_empty() {
+        let floor = stats.floor_now;
+        let guard = |m: &TriMesh, original: &[u32], faces: &[[u32; 3]]| {
+            let old: Vec<[u32; 3]> = original.iter().map(|&g| m.tris[g as usize]).collect();
+            let before = tally(&m.pos, &*counted, &old, &patch_pairs(m, original, &old));
+            let after = tally(&m.pos, &*counted, faces, &patch_pairs(m, original, faces));
+            judge(&before, &after, floor) == Verdict::Accept
+        };
+        let (regions, flips) =
+            untangle::guarded_flip_sequences(mesh, &*counted, fixed, locked, &bad, &guard, progress)?;
+        if regions > 0 {
+            stats.flip_sequences = regions;
+            stats.sequence_flips = flips;
+            let now = counted_faces(mesh, &*counted, progress)?;
+            left = now.len();
+            bad = now.into_iter().filter(|&f| counted.editable(mesh.tris[f as usize])).collect();
+        }
+    }
     for f in bad {
-        if counted.against(&mesh.pos, mesh.tris[f as usize]) {
+        if mesh.alive[f as usize] && counted.against(&mesh.pos, mesh.tris[f as usize]) {
             let attempt = last.get(&f).copied().unwrap_or_default();
             classify(mesh, fixed, f, attempt, &mut stats.left_why);
         }
     }
     stats.left = left;
-    stats.fixed = stats.counted_before - left;
+    stats.fixed = stats.counted_before.saturating_sub(left);
     Ok(stats)
 }
 
@@ -341,6 +372,30 @@ impl Edit<'_> {
         }
         Ok(bad)
     }
+}
+
+/// The pairs of adjacent faces' normals a neighbourhood state has: its faces `faces` among
+/// themselves (each pair once) and with the faces outside it across its rim (the mesh's faces
+/// not among `original`, the neighbourhood's face ids).
+fn patch_pairs(mesh: &TriMesh, original: &[u32], faces: &[[u32; 3]]) -> Vec<(Point3, Point3)> {
+    let pos = &mesh.pos;
+    let mut out = Vec::new();
+    for (i, &t) in faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let inside = faces.iter().position(|u| (0..3).any(|m| u[m] == b && u[(m + 1) % 3] == a));
+            match inside {
+                Some(j) if j > i => out.push((normal(pos, t), normal(pos, faces[j]))),
+                Some(_) => {}
+                None => {
+                    if let Some(g) = mesh.face_with_edge(b, a).filter(|g| !original.contains(g)) {
+                        out.push((normal(pos, t), normal(pos, mesh.tris[g as usize])));
+                    }
+                }
+            }
+        }
+    }
+    out
 }
 
 /// The smallest corner angle over the live, non-degenerate faces, degrees (180 for none).

@@ -234,3 +234,59 @@ fn a_flip_below_the_floor_is_made_when_the_mesh_is_already_thinner() {
     assert!((min_angle_of(&mesh) - thin).abs() < 1e-9, "{}", min_angle_of(&mesh));
     assert_eq!(mesh.pos, pos);
 }
+
+/// The flip search's collinear case ([`super::untangle`]'s flip-sequence test) under the count:
+/// a = (0, 0), m = (1, 0), b = (2, 0) on one line, a–m and b–c3 curve edges, every vertex fixed;
+/// face (a, m, c1) points down (doubled signed area −1.2, by hand) under (c1, b, a). Its one flip
+/// (a–c1) gives the zero-area (m, a, b), its corners cannot move, and a split is refused (the fine
+/// surface is given pointing down, so every split face opposes it): no single edit. Two flips
+/// (a–c1, then the zero-area face's long edge a–b) end with every face up, and a triangulation of
+/// the same hexagon (total area 8.8 by the shoelace formula); the curve edges stay.
+#[test]
+fn a_face_no_single_edit_fixes_is_fixed_by_a_flip_sequence() {
+    let pos = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.2, 0.0],
+        [3.0, -1.0, 0.0],
+        [3.0, 1.0, 0.0],
+        [1.0, 1.2, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let (a, m, b, c0, c1, c2, c3, c4, c5) = (0, 1, 2, 3, 4, 5, 6, 7, 8);
+    let tris = vec![
+        [a, c4, c5],
+        [a, c5, c0],
+        [a, m, c1],
+        [b, c1, c2],
+        [b, c2, c3],
+        [b, c3, c4],
+        [b, c4, a],
+        [c0, c1, m],
+        [c1, b, a],
+        [m, a, c0],
+    ];
+    let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
+    assert_eq!(up_faces(&mesh), 9);
+    let mut locked = EdgeSet::default();
+    locked.insert((a, m));
+    locked.insert((b, c3));
+    let mut up = vec![[0.0, 0.0, 1.0]; 9];
+    let down = vec![[0.0, 0.0, -1.0]; 9];
+    let s = repair_counted(&mut mesh, &mut up, &down, &[true; 9], &locked, &Progress::new()).unwrap();
+    assert_eq!((s.counted_before, s.edge_flips, s.vertex_moves, s.edge_splits), (1, 0, 0, 0), "{s:?}");
+    assert_eq!((s.flip_sequences, s.sequence_flips, s.left, s.fixed), (1, 2, 0, 1), "{s:?}");
+    assert_eq!((mesh.live_faces(), up_faces(&mesh)), (10, 10));
+    assert!(mesh.has_edge(a, m) && mesh.has_edge(b, c3), "a curve edge was flipped away");
+    assert_eq!(mesh.pos, pos);
+    let area: f64 = mesh
+        .live_triangles()
+        .iter()
+        .map(|t| {
+            triangle_cross(mesh.pos[t[0] as usize], mesh.pos[t[1] as usize], mesh.pos[t[2] as usize])[2] / 2.0
+        })
+        .sum();
+    assert!((area - 8.8).abs() < 1e-12, "{area}");
+}

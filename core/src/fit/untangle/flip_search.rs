@@ -37,6 +37,10 @@ const MAX_STATES: usize = 4_000;
 /// zero-area (its normal is round-off).
 const DEGENERATE: f64 = 1e-12;
 
+/// A rule every end state must pass to be kept, given the neighbourhood's original face ids and
+/// the state's faces (the last repair's rules: [`crate::fit::turned`]); none: the badness alone.
+pub(crate) type Guard<'a> = Option<&'a dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool>;
+
 /// What the flip-sequence pass did.
 #[derive(Debug, Default, Clone, Copy)]
 pub(super) struct SearchPass {
@@ -146,6 +150,7 @@ fn candidate_flips(patch: &Patch, mesh: &TriMesh, ctx: &Ctx) -> Vec<(usize, usiz
 struct Search<'a> {
     mesh: &'a TriMesh,
     ctx: &'a Ctx<'a>,
+    guard: Guard<'a>,
     states: usize,
     /// The best state seen: its badness, faces and depth (flips).
     best: ((usize, usize, f64), Vec<[u32; 3]>, usize),
@@ -158,7 +163,8 @@ impl Search<'_> {
         self.states += 1;
         let (turned, folded, e) = patch.badness();
         let (bt, bf, be) = self.best.0;
-        if (turned, folded) < (bt, bf) || ((turned, folded) == (bt, bf) && e < be - 1e-12) {
+        let better = (turned, folded) < (bt, bf) || ((turned, folded) == (bt, bf) && e < be - 1e-12);
+        if better && self.guard.is_none_or(|g| depth == 0 || g(self.mesh, &patch.original, &patch.faces)) {
             self.best = ((turned, folded, e), patch.faces.clone(), depth);
         }
         if depth == max_depth || self.best.0 .1 == 0 || self.states >= MAX_STATES {
@@ -190,13 +196,13 @@ impl Search<'_> {
 
 /// Replaces the neighbourhood of folded face `f` by the best flip sequence's faces when that has
 /// fewer folded faces; returns the number of flips applied, or the neighbourhood searched in vain.
-fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> std::result::Result<usize, Vec<u32>> {
+fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, guard: Guard, f: u32) -> std::result::Result<usize, Vec<u32>> {
     let original = neighbourhood(mesh, ctx, f);
     let faces: Vec<[u32; 3]> = original.iter().map(|&g| mesh.tris[g as usize]).collect();
     let quality_of: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
     let mut patch = Patch { original, faces, quality: quality_of };
     let before = patch.badness();
-    let mut search = Search { mesh, ctx, states: 0, best: (before, Vec::new(), 0) };
+    let mut search = Search { mesh, ctx, guard, states: 0, best: (before, Vec::new(), 0) };
     // Shortest sequences first: a fix by one or two flips changes least.
     for max_depth in 1..=MAX_DEPTH {
         search.visit(&mut patch, 0, max_depth, (u32::MAX, u32::MAX));
@@ -237,6 +243,7 @@ fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> std::result::Result<usiz
 pub(super) fn flip_sequences(
     mesh: &mut TriMesh,
     ctx: &Ctx,
+    guard: Guard,
     bad: &[u32],
     progress: &Progress,
 ) -> Result<SearchPass> {
@@ -249,7 +256,7 @@ pub(super) fn flip_sequences(
         if searched.contains(&f) || !mesh.alive[f as usize] || !ctx.folded(mesh, f) {
             continue;
         }
-        match repair_one(mesh, ctx, f) {
+        match repair_one(mesh, ctx, guard, f) {
             Ok(flips) => {
                 out.regions += 1;
                 out.flips += flips;

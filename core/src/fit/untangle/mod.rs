@@ -176,7 +176,7 @@ pub fn untangle_polled(
             break;
         }
         let bad = folded_faces(mesh, &ctx, progress)?;
-        let pass = flip_search::flip_sequences(mesh, &ctx, &bad, progress)?;
+        let pass = flip_search::flip_sequences(mesh, &ctx, None, &bad, progress)?;
         if pass.regions == 0 {
             break;
         }
@@ -186,6 +186,23 @@ pub fn untangle_polled(
     }
     stats.folded_after = left;
     Ok(stats)
+}
+
+/// One pass of flip sequences ([`flip_search`]) over the faces `bad` that are turned against
+/// `reference`, keeping only end states `guard` accepts (the last repair's: [`super::turned`]).
+/// Returns (neighbourhoods replaced, flips made).
+pub(crate) fn guarded_flip_sequences(
+    mesh: &mut TriMesh,
+    reference: &dyn Reference,
+    fixed: &[bool],
+    locked: &EdgeSet,
+    bad: &[u32],
+    guard: &dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool,
+    progress: &Progress,
+) -> Result<(usize, usize)> {
+    let ctx = Ctx { reference, fixed, locked };
+    let pass = flip_search::flip_sequences(mesh, &ctx, Some(guard), bad, progress)?;
+    Ok((pass.regions, pass.flips))
 }
 
 /// The live folded faces in id order, polling every [`POLL_FACES`] face ids.
