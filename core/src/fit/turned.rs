@@ -153,8 +153,8 @@ pub struct TurnedStats {
     pub vertex_moves: usize,
     /// Non-curve edges split at a new free vertex (each adds one vertex and two faces).
     pub edge_splits: usize,
-    /// Counted faces not tried because the maps turn space inside out at a corner
-    /// ([`Counted::editable`]).
+    /// Counted faces left (at the end) that were not tried because the maps turn space inside
+    /// out at a corner ([`Counted::editable`]).
     pub skipped_inverted_by_maps: usize,
     /// Edits that would have lowered the count but added a folded edge (not made).
     pub refused_fold: usize,
@@ -256,7 +256,6 @@ pub fn repair_counted(
     stats.counted_before = bad.len();
     let mut left = bad.len();
     bad.retain(|&f| counted.editable(mesh.tris[f as usize]));
-    stats.skipped_inverted_by_maps = stats.counted_before - bad.len();
     // The last attempt on each face (why a face still counted at the end was left).
     let mut last: HashMap<u32, Attempt> = HashMap::new();
     let edit = Edit { surface, fixed, locked, progress };
@@ -295,16 +294,26 @@ pub fn repair_counted(
             let now = counted_faces(mesh, &*counted, progress)?;
             left = now.len();
             bad = now.into_iter().filter(|&f| counted.editable(mesh.tris[f as usize])).collect();
+            // The faces the sequences made are edited once more (each face left then has an
+            // attempt to be classified by).
+            bad = edit.passes(mesh, counted, bad, &mut stats, &mut last, &mut left)?;
         }
     }
-    for f in bad {
-        if mesh.alive[f as usize] && counted.against(&mesh.pos, mesh.tris[f as usize]) {
+    drop(bad);
+    // The faces left, counted again (what the report's `flipped_faces` will say), each either
+    // not editable or classified by its last attempt: `left` is their sum by construction.
+    let end = if stats.counted_before > 0 { counted_faces(mesh, &*counted, progress)? } else { Vec::new() };
+    stats.skipped_inverted_by_maps = 0;
+    for &f in &end {
+        if counted.editable(mesh.tris[f as usize]) {
             let attempt = last.get(&f).copied().unwrap_or_default();
             classify(mesh, fixed, f, attempt, &mut stats.left_why);
+        } else {
+            stats.skipped_inverted_by_maps += 1;
         }
     }
-    stats.left = left;
-    stats.fixed = stats.counted_before.saturating_sub(left);
+    stats.left = end.len();
+    stats.fixed = stats.counted_before.saturating_sub(stats.left);
     Ok(stats)
 }
 
