@@ -235,7 +235,7 @@ fn a_flip_below_the_floor_is_made_when_the_mesh_is_already_thinner() {
     assert_eq!(mesh.pos, pos);
 }
 
-/// The flip search's collinear case ([`super::untangle`]'s flip-sequence test) under the count:
+/// The flip search's collinear case (`untangle::flip_search::tests::collinear_overlap`) under the count:
 /// a = (0, 0), m = (1, 0), b = (2, 0) on one line, a–m and b–c3 curve edges, every vertex fixed;
 /// face (a, m, c1) points down (doubled signed area −1.2, by hand) under (c1, b, a). Its one flip
 /// (a–c1) gives the zero-area (m, a, b), its corners cannot move, and a split is refused (the fine
@@ -244,30 +244,8 @@ fn a_flip_below_the_floor_is_made_when_the_mesh_is_already_thinner() {
 /// the same hexagon (total area 8.8 by the shoelace formula); the curve edges stay.
 #[test]
 fn a_face_no_single_edit_fixes_is_fixed_by_a_flip_sequence() {
-    let pos = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [2.0, 0.0, 0.0],
-        [-1.0, -1.0, 0.0],
-        [1.0, -1.2, 0.0],
-        [3.0, -1.0, 0.0],
-        [3.0, 1.0, 0.0],
-        [1.0, 1.2, 0.0],
-        [-1.0, 1.0, 0.0],
-    ];
-    let (a, m, b, c0, c1, c2, c3, c4, c5) = (0, 1, 2, 3, 4, 5, 6, 7, 8);
-    let tris = vec![
-        [a, c4, c5],
-        [a, c5, c0],
-        [a, m, c1],
-        [b, c1, c2],
-        [b, c2, c3],
-        [b, c3, c4],
-        [b, c4, a],
-        [c0, c1, m],
-        [c1, b, a],
-        [m, a, c0],
-    ];
+    let (pos, tris) = crate::fit::untangle::flip_search::tests::collinear_overlap();
+    let (a, m, b, c3) = (0, 1, 2, 6);
     let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
     assert_eq!(up_faces(&mesh), 9);
     let mut locked = EdgeSet::default();

@@ -268,7 +268,7 @@ pub(super) fn flip_sequences(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::super::{untangle, EdgeSet};
     use super::*;
 
@@ -291,8 +291,9 @@ mod tests {
     /// the zero-area (m, a, b) (refused by the one-flip rule), and flipping that face's long edge
     /// a–b then finishes: (a, m, c4), (m, b, c4). The hexagon c0…c5 with a, m, b inside has such
     /// a fold-free triangulation (the one the fold was made from by flips), so 0 is reachable.
-    #[test]
-    fn an_overlap_over_three_collinear_fixed_points_is_undone_by_two_flips() {
+    /// Vertices a, m, b, c0, …, c5 are 0, …, 8 (plane z = 0). Also the last repair's
+    /// flip-sequence case ([`crate::fit::turned`]).
+    pub(crate) fn collinear_overlap() -> (Vec<crate::mesh::Point3>, Vec<[u32; 3]>) {
         let pos = vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -317,6 +318,13 @@ mod tests {
             [c1, b, a],
             [m, a, c0],
         ];
+        (pos, tris)
+    }
+
+    #[test]
+    fn an_overlap_over_three_collinear_fixed_points_is_undone_by_two_flips() {
+        let (pos, tris) = collinear_overlap();
+        let (a, m, b, c1, c3) = (0, 1, 2, 4, 6);
         let mut mesh = TriMesh::new(pos.clone(), tris).unwrap();
         assert_eq!(faces_not_up(&mesh), vec![[a, m, c1]]);
         let mut locked = EdgeSet::default();

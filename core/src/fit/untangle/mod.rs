@@ -25,7 +25,7 @@ use super::trimesh::TriMesh;
 use super::uvs::{self, UvMove};
 
 mod energy;
-mod flip_search;
+pub(crate) mod flip_search;
 mod folds;
 mod kernel;
 mod patch;
