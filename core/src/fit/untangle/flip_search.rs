@@ -39,7 +39,10 @@ const DEGENERATE: f64 = 1e-12;
 
 /// A rule every end state must pass to be kept, given the neighbourhood's original face ids and
 /// the state's faces (the last repair's rules: [`crate::fit::turned`]); none: the badness alone.
-pub(crate) type Guard<'a> = Option<&'a dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool>;
+pub(crate) type Guard<'a> = Option<&'a GuardFn<'a>>;
+
+/// The rule of a [`Guard`]: (mesh, original face ids, the state's faces) → keep.
+pub(crate) type GuardFn<'a> = dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool + 'a;
 
 /// What the flip-sequence pass did.
 #[derive(Debug, Default, Clone, Copy)]

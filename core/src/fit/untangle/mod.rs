@@ -197,7 +197,7 @@ pub(crate) fn guarded_flip_sequences(
     fixed: &[bool],
     locked: &EdgeSet,
     bad: &[u32],
-    guard: &dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool,
+    guard: &flip_search::GuardFn<'_>,
     progress: &Progress,
 ) -> Result<(usize, usize)> {
     let ctx = Ctx { reference, fixed, locked };
