@@ -27,20 +27,26 @@
 //! template face its corners share, so an untouched or subdivided template face is compared with
 //! its own normal (vertex normals are ambiguous at creases and thin fins).
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::geometry::{add, cross, dot, normalize, scale, triangle_cross};
+use crate::geometry::{add, dot, normalize, scale, triangle_cross};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::rbf::Rbf;
 
+mod jacobian;
 mod repair;
+mod replay;
+
+pub(super) use jacobian::det;
+use jacobian::{cofactor, field_step, frobenius, mat_vec};
+pub use jacobian::{cofactor_times, mat_mul, push_normal};
 pub use repair::AfterLastMap;
+use replay::{Replay, Step};
 
 /// A 3×3 Jacobian: `j[r][c]` = ∂(output r)/∂(input c).
 pub type Jacobian = [[f64; 3]; 3];
@@ -59,29 +65,6 @@ enum Place {
     Edge(u32, u32),
     /// Across several template faces (a split of a segment between two of them).
     Across,
-}
-
-/// A map whose Jacobians were summed in single precision ([`Orientation::push_field`]): what it
-/// takes to evaluate them again exactly.
-#[derive(Clone)]
-enum Step {
-    /// x ↦ x + step · field(x), from the positions `before` it.
-    Field { field: Arc<Rbf>, step: f64, before: Vec<Point3> },
-    /// An exact map after a bounded one: its Jacobian per vertex.
-    Exact(Vec<Jacobian>),
-}
-
-/// From the first bounded map on, what re-evaluating a vertex's composite Jacobian exactly takes:
-/// the composite before that map, every map since, and the lineage of the vertices added since.
-#[derive(Clone)]
-struct Replay {
-    origin: Vec<Jacobian>,
-    steps: Vec<Step>,
-    /// Per vertex added after `origin`: its parents and how many `steps` it had then.
-    added: Vec<([(u32, f64); 3], usize)>,
-    /// False once a rollback removed a vertex older than the first bounded map (no caller does):
-    /// faces the bounds leave open are then decided by their approximate Jacobians.
-    valid: bool,
 }
 
 /// Per working vertex of the fit: the composite Jacobian of every map applied so far, a bound on
@@ -112,52 +95,6 @@ pub struct Orientation {
     /// Per vertex: the last map pushed (the fine RBF, in the fit) turns space inside out there
     /// ([`Side::LastMap`]).
     last_inverted: Vec<bool>,
-}
-
-/// `cof(J)·n` and `det J`: with the columns a, b, c of J, cof(J) = [b×c, c×a, a×b].
-pub fn cofactor_times(j: &Jacobian, n: Point3) -> (Point3, f64) {
-    let col = |k: usize| [j[0][k], j[1][k], j[2][k]];
-    let (a, b, c) = (col(0), col(1), col(2));
-    let (bc, ca, ab) = (cross(b, c), cross(c, a), cross(a, b));
-    let v = add(add(scale(bc, n[0]), scale(ca, n[1])), scale(ab, n[2]));
-    (v, dot(a, bc))
-}
-
-/// The unit covector J⁻ᵀ·n (the normal n pushed forward), zero where it vanishes.
-pub fn push_normal(j: &Jacobian, n: Point3) -> Point3 {
-    let (c, det) = cofactor_times(j, n);
-    normalize(if det > 0.0 { c } else { scale(c, -1.0) })
-}
-
-/// cof(J) as a matrix: cof(J)·n = [b×c, c×a, a×b]·n for the columns a, b, c of J, as
-/// [`cofactor_times`] computes it.
-fn cofactor(j: &Jacobian) -> Jacobian {
-    let col = |k: usize| [j[0][k], j[1][k], j[2][k]];
-    let (a, b, c) = (col(0), col(1), col(2));
-    let (bc, ca, ab) = (cross(b, c), cross(c, a), cross(a, b));
-    std::array::from_fn(|r| [bc[r], ca[r], ab[r]])
-}
-
-fn mat_vec(m: &Jacobian, n: Point3) -> Point3 {
-    [dot(m[0], n), dot(m[1], n), dot(m[2], n)]
-}
-
-/// `a · b` for 3×3 matrices.
-pub fn mat_mul(a: &Jacobian, b: &Jacobian) -> Jacobian {
-    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
-}
-
-pub(super) fn det(j: &Jacobian) -> f64 {
-    cofactor_times(j, [0.0; 3]).1
-}
-
-fn frobenius(j: &Jacobian) -> f64 {
-    j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt()
-}
-
-/// I + step · g: the Jacobian of x ↦ x + step · s(x) from the field's gradient g.
-fn field_step(g: &Jacobian, step: f64) -> Jacobian {
-    std::array::from_fn(|r| std::array::from_fn(|c| step * g[r][c] + if r == c { 1.0 } else { 0.0 }))
 }
 
 /// One corner of a face: its pushed-forward normal and how far the Jacobian's error bound `e`
@@ -624,28 +561,6 @@ impl Orientation {
         tris.iter().filter(|t| t.iter().filter(|&&v| inverted(v)).count() >= 2).count()
     }
 
-    /// Exact Jacobians (error 0) at `vertices`, replayed from the first bounded map (in parallel,
-    /// each vertex with its own memo: lineages rarely overlap); the stored approximation (with its
-    /// bound) where no replay is kept.
-    fn exact_at(&self, vertices: impl Iterator<Item = u32>) -> impl Fn(u32) -> (Jacobian, f64) + '_ {
-        let mut wanted: Vec<u32> = vertices.collect();
-        wanted.sort_unstable();
-        wanted.dedup();
-        let replay = self.replay.as_ref().filter(|r| r.valid);
-        let found: HashMap<u32, (Jacobian, f64)> = wanted
-            .par_iter()
-            .map(|&v| {
-                let stored = (self.jacobians[v as usize], self.errors[v as usize]);
-                let exact = replay.and_then(|r| {
-                    let w = self.working.as_ref().map_or(v, |m| m[v as usize]);
-                    replay_jacobian(r, w, r.steps.len(), &mut HashMap::new()).map(|j| (j, 0.0))
-                });
-                (v, exact.unwrap_or(stored))
-            })
-            .collect();
-        move |v| found.get(&v).copied().unwrap_or((self.jacobians[v as usize], self.errors[v as usize]))
-    }
-
     /// The same, with only the vertices `keep` keeps (a renumbering after removals).
     pub fn renumbered(mut self, keep: &super::compact::Renumber) -> Orientation {
         let working: Vec<u32> = match &self.working {
@@ -661,47 +576,6 @@ impl Orientation {
         self.cofactors = keep.vec(&self.cofactors);
         self
     }
-}
-
-/// Working vertex `v`'s composite Jacobian after the first `upto` steps of the replay, in f64:
-/// its origin (or its parents' blend when it was added), times each step since. None when the
-/// lineage does not reach (a vertex the replay does not know).
-fn replay_jacobian(
-    r: &Replay,
-    v: u32,
-    upto: usize,
-    memo: &mut HashMap<(u32, usize), Jacobian>,
-) -> Option<Jacobian> {
-    if let Some(j) = memo.get(&(v, upto)) {
-        return Some(*j);
-    }
-    let (mut j, from) = match r.origin.get(v as usize) {
-        Some(j) => (*j, 0),
-        None => {
-            let &(parents, epoch) = r.added.get(v as usize - r.origin.len())?;
-            let mut j = [[0.0; 3]; 3];
-            for &(p, w) in parents.iter().filter(|x| x.1 > 0.0) {
-                let jp = replay_jacobian(r, p, epoch, memo)?;
-                for row in 0..3 {
-                    for c in 0..3 {
-                        j[row][c] += w * jp[row][c];
-                    }
-                }
-            }
-            (j, epoch)
-        }
-    };
-    for step in &r.steps[from.min(upto)..upto] {
-        let s = match step {
-            Step::Field { field, step, before } => {
-                field_step(&field.gradient(*before.get(v as usize)?), *step)
-            }
-            Step::Exact(per_vertex) => *per_vertex.get(v as usize)?,
-        };
-        j = mat_mul(&s, &j);
-    }
-    memo.insert((v, upto), j);
-    Some(j)
 }
 
 #[cfg(test)]

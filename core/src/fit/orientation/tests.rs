@@ -1,7 +1,7 @@
 //! Tests of the orientation count (moved out of `orientation.rs`).
 
 use super::*;
-use crate::geometry::norm;
+use crate::geometry::{cross, norm};
 
 fn sphere() -> (Vec<Point3>, Vec<[u32; 3]>) {
     let m = crate::shapes::icosphere(3, 1.0);
