@@ -266,11 +266,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     parents.extend_from_slice(&realised.added);
     // Vertices split into crossed edges take the reference normal of their edge.
     for a in &realised.added {
-        let n = add(
-            scale(reference_normals[a[0].0 as usize], a[0].1),
-            scale(reference_normals[a[1].0 as usize], a[1].1),
-        );
-        reference_normals.push(crate::geometry::normalize(n));
+        push_edge_normal(&mut reference_normals, a);
     }
     let mut curve_edges = untangle::EdgeSet::default();
     for c in &realised.chains {
@@ -491,11 +487,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     for a in &turned.added {
         parents.push(*a);
         realised.on_curve.push(false);
-        let n = add(
-            scale(reference_normals[a[0].0 as usize], a[0].1),
-            scale(reference_normals[a[1].0 as usize], a[1].1),
-        );
-        reference_normals.push(crate::geometry::normalize(n));
+        push_edge_normal(&mut reference_normals, a);
     }
     mesh.check_growth("turned_faces")?;
     if turned.vertex_moves + turned.edge_splits > 0 {
@@ -679,6 +671,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 }
 
 /// Distance helper kept here for the report.
+/// Appends the reference normal of a vertex added on an edge: its two ends' normals (`p`'s first
+/// two parents) blended by their weights, normalised (the re-triangulation's and the last
+/// repair's splits).
+fn push_edge_normal(normals: &mut Vec<Point3>, p: &[(u32, f64); 3]) {
+    let n = add(scale(normals[p[0].0 as usize], p[0].1), scale(normals[p[1].0 as usize], p[1].1));
+    normals.push(crate::geometry::normalize(n));
+}
+
 pub(crate) fn point_segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
     dist(p, crate::geometry::closest_on_segment(p, a, b))
 }

@@ -263,18 +263,6 @@ impl Orientation {
         }
     }
 
-    /// One vertex added as the blend `p` of older ones (the last repair's edge splits, judged
-    /// before they are made): what [`Orientation::sync`] does for each vertex it is given.
-    pub fn push_blend(&mut self, p: &[(u32, f64); 3]) {
-        self.push_vertex(p);
-    }
-
-    /// Forgets the vertices from `want` on (a vertex of [`Orientation::push_blend`] whose edit was
-    /// not made).
-    pub fn forget_from(&mut self, want: usize) {
-        self.truncate_to(want);
-    }
-
     /// Forgets the vertices from `want` on.
     fn truncate_to(&mut self, want: usize) {
         self.cofactors.truncate(want);

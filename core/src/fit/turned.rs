@@ -37,7 +37,7 @@ use crate::mesh::Point3;
 
 use super::degenerate::is_zero_area;
 use super::orientation::Orientation;
-use super::reference::Reference;
+use super::reference::SplitReference;
 use super::trimesh::{EdgeSet, TriMesh};
 use super::untangle::{self, FOLD_ANGLE_DEG};
 use super::uvs::{self, UvMove};
@@ -82,31 +82,12 @@ pub trait Counted: Sync {
     fn editable(&self, _t: [u32; 3]) -> bool {
         true
     }
-
-    /// Takes the mesh's next vertex, added as the blend `parents` of older ones (an edge split);
-    /// false when the count cannot (then no split is made).
-    fn add_vertex(&mut self, _parents: &[(u32, f64); 3]) -> bool {
-        false
-    }
-
-    /// Forgets the vertices from `n` on (a split judged and not made).
-    fn truncate_vertices(&mut self, _n: usize) {}
 }
 
 /// A per-vertex field of unit normals: a face's reference is the sum of its corners' (tests).
 impl Counted for Vec<Point3> {
     fn direction(&self, t: [u32; 3]) -> Point3 {
         add(add(self[t[0] as usize], self[t[1] as usize]), self[t[2] as usize])
-    }
-
-    fn add_vertex(&mut self, parents: &[(u32, f64); 3]) -> bool {
-        let n = parents.iter().fold([0.0; 3], |s, &(v, w)| add(s, scale(self[v as usize], w)));
-        self.push(normalize(n));
-        true
-    }
-
-    fn truncate_vertices(&mut self, n: usize) {
-        self.truncate(n);
     }
 }
 
@@ -127,17 +108,6 @@ impl Counted for Orientation {
     /// made against the truth). Those faces stay counted, as `faces_inverted_by_maps` too.
     fn editable(&self, t: [u32; 3]) -> bool {
         !self.inverted_at_a_corner(&t)
-    }
-
-    /// The new vertex takes its parents' maps, as [`Orientation::sync`] gives every vertex the
-    /// fit adds.
-    fn add_vertex(&mut self, parents: &[(u32, f64); 3]) -> bool {
-        self.push_blend(parents);
-        true
-    }
-
-    fn truncate_vertices(&mut self, n: usize) {
-        self.forget_from(n);
     }
 }
 
@@ -212,9 +182,10 @@ pub struct Left {
     pub surface: usize,
     /// Every edit tried left the count where it acts as high as before.
     pub no_gain: usize,
-    /// Faces a flip sequence made (it lowered the count in its neighbourhood but left these),
-    /// not edited again: single edits after the sequences, measured (session 19), fixed 16 more
-    /// on the first deformed set but turned faces against the fine surface.
+    /// Faces not tried since they were made: by a flip sequence (it lowered the count in its
+    /// neighbourhood but left these), or by an edit of the last pass of single edits. Single
+    /// edits after the sequences, measured (session 19), fixed 16 more on the first deformed set
+    /// but turned faces against the fine surface.
     pub made_by_sequence: usize,
     /// Of all the above: faces whose three corners are fixed (curve vertices, the boundary).
     pub all_corners_fixed: usize,
@@ -223,8 +194,6 @@ pub struct Left {
 /// What one attempt on a face met: the edits tried and the refusals among them.
 #[derive(Debug, Clone, Copy, Default)]
 struct Attempt {
-    /// Not an attempt: the face was made by a flip sequence and not tried since.
-    sequence: bool,
     candidates: usize,
     fold: bool,
     floor: bool,
@@ -250,7 +219,7 @@ enum Verdict {
 /// vertex normals ([`split::against_surface`]), which no face a split makes may oppose.
 pub fn repair_counted(
     mesh: &mut TriMesh,
-    counted: &mut (impl Counted + Reference),
+    counted: &mut (impl Counted + SplitReference),
     surface: &[Point3],
     fixed: &[bool],
     locked: &EdgeSet,
@@ -306,9 +275,7 @@ pub fn repair_counted(
     stats.skipped_inverted_by_maps = 0;
     for &f in &end {
         if counted.editable(mesh.tris[f as usize]) {
-            let made = Attempt { sequence: true, ..Attempt::default() };
-            let attempt = last.get(&f).copied().unwrap_or(made);
-            classify(mesh, fixed, f, attempt, &mut stats.left_why);
+            classify(mesh, fixed, f, last.get(&f).copied(), &mut stats.left_why);
         } else {
             stats.skipped_inverted_by_maps += 1;
         }
@@ -333,7 +300,7 @@ impl Edit<'_> {
     fn passes(
         &self,
         mesh: &mut TriMesh,
-        counted: &mut impl Counted,
+        counted: &mut (impl Counted + SplitReference),
         mut bad: Vec<u32>,
         stats: &mut TurnedStats,
         last: &mut HashMap<u32, Attempt>,
@@ -482,21 +449,29 @@ fn note(stats: &mut TurnedStats, attempt: &mut Attempt, v: Verdict) {
     }
 }
 
-/// Adds the left face `f` to `why` by its last attempt.
-fn classify(mesh: &TriMesh, fixed: &[bool], f: u32, attempt: Attempt, why: &mut Left) {
+/// Adds the left face `f` to `why` by its last attempt (none: not tried since it was made).
+fn classify(mesh: &TriMesh, fixed: &[bool], f: u32, attempt: Option<Attempt>, why: &mut Left) {
+    let Some(attempt) = attempt else {
+        why.made_by_sequence += 1;
+        count_all_fixed(mesh, fixed, f, why);
+        return;
+    };
     if attempt.fold {
         why.fold += 1;
     } else if attempt.floor {
         why.floor += 1;
     } else if attempt.surface {
         why.surface += 1;
-    } else if attempt.sequence {
-        why.made_by_sequence += 1;
     } else if attempt.candidates == 0 {
         why.no_edit += 1;
     } else {
         why.no_gain += 1;
     }
+    count_all_fixed(mesh, fixed, f, why);
+}
+
+/// Counts face `f` in `why.all_corners_fixed` when its three corners are fixed (or boundary).
+fn count_all_fixed(mesh: &TriMesh, fixed: &[bool], f: u32, why: &mut Left) {
     let is_fixed = |v: u32| fixed.get(v as usize).copied().unwrap_or(true) || mesh.is_boundary_vertex(v);
     if mesh.tris[f as usize].iter().all(|&v| is_fixed(v)) {
         why.all_corners_fixed += 1;

@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{add, dot, normalize, scale};
 use crate::mesh::Point3;
 
+use super::super::reference::SplitReference;
 use super::super::trimesh::{EdgeSet, TriMesh};
 use super::super::uvs::{self, UvMove};
 use super::{judge, normal, note, place, quads, tally, Attempt, Counted, Quad, TurnedStats, Verdict};
@@ -29,7 +30,7 @@ struct SplitChoice {
 /// ½ each) are in `stats.added`.
 pub(super) fn try_split(
     mesh: &mut TriMesh,
-    counted: &mut impl Counted,
+    counted: &mut (impl Counted + SplitReference),
     surface: &[Point3],
     locked: &EdgeSet,
     f: u32,
@@ -41,9 +42,10 @@ pub(super) fn try_split(
     let mut best: Option<SplitChoice> = None;
     for Quad { k, a, b, c, g, d } in quads(mesh, locked, f) {
         let tg = mesh.tris[g as usize];
-        if d == c || !counted.add_vertex(&split_parents(a, b)) {
+        if d == c {
             continue;
         }
+        counted.push_midpoint(a, b);
         let outer = |x: u32, y: u32, own: u32| mesh.across(own, x, y).map(|h| mesh.tris[h as usize]);
         let (oca, obc, oad, odb) = (outer(c, a, f), outer(b, c, f), outer(a, d, g), outer(d, b, g));
         let new = [[a, m, c], [m, b, c], [b, m, d], [m, a, d]];
@@ -112,10 +114,7 @@ pub(super) fn try_split(
     let (a, b) = (t[choice.k], t[(choice.k + 1) % 3]);
     // Its UV is read where it lands, on the faces before the split.
     let weights = uvs::record(mesh, a, choice.at).map_or(split_parents(a, b), |u| u.weights);
-    if !counted.add_vertex(&split_parents(a, b)) {
-        mesh.pop_vertex();
-        return Ok(None);
-    }
+    counted.push_midpoint(a, b);
     let faces_before = mesh.live_faces();
     mesh.pop_vertex();
     let made = mesh.split_edge(a, b, choice.at);
