@@ -183,12 +183,25 @@ pub struct Left {
     /// Every edit tried left the count where it acts as high as before.
     pub no_gain: usize,
     /// Faces not tried since they were made: by a flip sequence (it lowered the count in its
-    /// neighbourhood but left these), or by an edit of the last pass of single edits. Single
+    /// neighbourhood but left these), or by an edit of the last pass of single edits (a face
+    /// a sequence renumbers but leaves as it was keeps its last attempt). Single
     /// edits after the sequences, measured (session 19), fixed 16 more on the first deformed set
     /// but turned faces against the fine surface.
     pub made_by_sequence: usize,
     /// Of all the above: faces whose three corners are fixed (curve vertices, the boundary).
     pub all_corners_fixed: usize,
+}
+
+/// A face by its corners, rotated to start at the smallest (the same oriented triangle whatever
+/// its id or first corner).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct FaceKey([u32; 3]);
+
+impl FaceKey {
+    fn of(t: [u32; 3]) -> Self {
+        let k = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+        FaceKey([t[k], t[(k + 1) % 3], t[(k + 2) % 3]])
+    }
 }
 
 /// What one attempt on a face met: the edits tried and the refusals among them.
@@ -234,8 +247,10 @@ pub fn repair_counted(
     stats.counted_before = bad.len();
     let mut left = bad.len();
     bad.retain(|&f| counted.editable(mesh.tris[f as usize]));
-    // The last attempt on each face (why a face still counted at the end was left).
-    let mut last: HashMap<u32, Attempt> = HashMap::new();
+    // The last attempt on each face (why a face still counted at the end was left), by its
+    // corners: a flip sequence gives the faces of its neighbourhood new ids, also the ones it
+    // leaves as they were.
+    let mut last: HashMap<FaceKey, Attempt> = HashMap::new();
     let edit = Edit { surface, fixed, locked, progress };
     bad = edit.passes(mesh, counted, bad, &mut stats, &mut last, &mut left)?;
     // Faces the floor left, where the mesh is already thinner elsewhere: an edit whose faces are
@@ -275,7 +290,8 @@ pub fn repair_counted(
     stats.skipped_inverted_by_maps = 0;
     for &f in &end {
         if counted.editable(mesh.tris[f as usize]) {
-            classify(mesh, fixed, f, last.get(&f).copied(), &mut stats.left_why);
+            let attempt = last.get(&FaceKey::of(mesh.tris[f as usize])).copied();
+            classify(mesh, fixed, f, attempt, &mut stats.left_why);
         } else {
             stats.skipped_inverted_by_maps += 1;
         }
@@ -303,7 +319,7 @@ impl Edit<'_> {
         counted: &mut (impl Counted + SplitReference),
         mut bad: Vec<u32>,
         stats: &mut TurnedStats,
-        last: &mut HashMap<u32, Attempt>,
+        last: &mut HashMap<FaceKey, Attempt>,
         left: &mut usize,
     ) -> Result<Vec<u32>> {
         for _ in 0..PASSES {
@@ -315,6 +331,7 @@ impl Edit<'_> {
                     continue;
                 }
                 stats.tried += 1;
+                let key = FaceKey::of(mesh.tris[f as usize]);
                 let mut attempt = Attempt::default();
                 let gain = if let Some(g) = try_flip(mesh, &*counted, self.locked, f, stats, &mut attempt) {
                     stats.edge_flips += 1;
@@ -326,7 +343,7 @@ impl Edit<'_> {
                     try_split(mesh, counted, self.surface, self.locked, f, stats, &mut attempt)?
                         .inspect(|_| stats.edge_splits += 1)
                 };
-                last.insert(f, attempt);
+                last.insert(key, attempt);
                 match gain {
                     Some((g, touched)) => {
                         *left -= g;

@@ -268,3 +268,15 @@ fn a_face_no_single_edit_fixes_is_fixed_by_a_flip_sequence() {
         .sum();
     assert!((area - 8.8).abs() < 1e-12, "{area}");
 }
+
+/// A face keeps its key under a rotation of its corners (a flip sequence re-writes a face it
+/// leaves as it was with any first corner, under a new id); the reversed face is another face.
+#[test]
+fn a_face_key_is_its_oriented_triangle() {
+    let k = FaceKey::of([7, 3, 5]);
+    assert_eq!(k, FaceKey([3, 5, 7]));
+    assert_eq!(FaceKey::of([3, 5, 7]), k);
+    assert_eq!(FaceKey::of([5, 7, 3]), k);
+    assert_ne!(FaceKey::of([7, 5, 3]), k);
+    assert_eq!(FaceKey::of([7, 5, 3]), FaceKey([3, 7, 5]));
+}
