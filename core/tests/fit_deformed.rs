@@ -8,7 +8,7 @@
 mod fit_support;
 
 use meshwork_core::fit::testdata::{
-    crossing_pairs, plane_sections, section_regions, sweep_planes, twist, TruthSurface,
+    bend, crossing_pairs, plane_sections, section_regions, sweep_planes, twist, TruthSurface,
 };
 use meshwork_core::job::{self, JobKind};
 use meshwork_core::mesh::Point3;
@@ -119,4 +119,21 @@ fn cad_parts_under_their_own_sections_with_pairs_meet_the_bar() {
             f.faces
         );
     }
+}
+
+/// homer under its bent sections with pairs: the last repair's only edits there are flip
+/// sequences (7 flips, no single flip or split), and the output must hold them. Until session 20
+/// the output's faces were read again only after single flips or splits, so the report counted 7
+/// flipped faces where the repair had left 3. Invariant: the report's count is the repair's
+/// own count of the faces it left (two independent counts of one mesh, before and after the
+/// renumbering of the output).
+#[test]
+fn the_output_holds_the_last_repairs_flip_sequences() {
+    let f = fit_own_sections("homer", |p| bend(p, 1.0), true);
+    let turned = &f.report["turned_faces"];
+    assert!(
+        turned["sequence_flips"].as_u64().is_some_and(|n| n > 0),
+        "the case makes flip sequences: {turned}"
+    );
+    assert_eq!(f.report["flipped_faces"], turned["left"], "{turned}");
 }

@@ -493,10 +493,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     if turned.vertex_moves + turned.edge_splits > 0 {
         out_pos.clone_from(&mesh.pos);
     }
-    if turned.edge_flips + turned.edge_splits > 0 {
+    // Whatever the pass changed (single flips, flip sequences, splits), the faces are read again
+    // when they differ: a test of its counters here missed the sequences until session 20 and
+    // dropped their flips from the output.
+    let turned_tris = mesh.live_triangles();
+    if turned_tris != out_tris {
         // Flipped and split edges are never curve edges: the regions are the same, relabelled for
         // the new face list.
-        out_tris = mesh.live_triangles();
+        out_tris = turned_tris;
         (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
         if keep_groups {
             tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
