@@ -31,6 +31,13 @@ pub fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
     if m.groups.len() as u64 != r["regions"].as_u64().unwrap_or(0) && r["template_groups_kept"] == 0 {
         bad.push(format!("{} groups vs {} regions", m.groups.len(), r["regions"]));
     }
+    // The report's count of turned faces is the last repair's own count of those it left (a
+    // stale face list once dropped the repair's flip sequences from the output, session 20).
+    if let Some(left) = r["turned_faces"]["left"].as_u64() {
+        if r["flipped_faces"].as_u64() != Some(left) {
+            bad.push(format!("flipped_faces {} but the last repair left {left}", r["flipped_faces"]));
+        }
+    }
     let used: std::collections::HashSet<u32> = m.faces.indices().iter().copied().collect();
     if used.len() < m.positions.len() {
         bad.push(format!("{} output vertices in no face", m.positions.len() - used.len()));
