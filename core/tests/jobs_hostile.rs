@@ -345,3 +345,34 @@ fn extents_whose_areas_underflow_are_refused_by_every_job_but_convert() {
     let point = tris(vec![[0.5; 3]; 4], &[[0, 1, 2], [0, 2, 3]]);
     assert!(run(JobKind::Repair, vec![point], json!({}), &Progress::new()).is_ok());
 }
+
+/// Found by the CLI fuzz campaign: `meshwork convert` of a valid mesh with coordinates near 1e149
+/// (inside the ±1e150 every job accepts) to `.stl` exited 0 and wrote infinities, because binary
+/// STL stores f32: the file was refused by our own reader ("coordinate is NaN or infinite"). The
+/// STL writer now refuses, naming the vertex, as the GLB writer did; OBJ, PLY and OFF keep it.
+#[test]
+fn stl_output_refuses_coordinates_beyond_f32_naming_the_vertex() {
+    use meshwork_core::io::{self, Format, ReadOptions};
+    let mut mesh = icosphere(1, 1.0);
+    mesh.positions[5][2] = 1e39;
+    let out = run(JobKind::Convert, vec![mesh.clone()], json!({}), &Progress::new()).expect("convert");
+    let e = io::write(&out.meshes[0], Format::Stl).expect_err("STL cannot hold 1e39");
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::InvalidMesh { location: meshwork_core::error::Location::Vertex(5), .. }),
+        "{msg}"
+    );
+    assert!(msg.contains("1e39") && msg.contains("f32"), "{msg}");
+    for f in [Format::Glb, Format::Gltf] {
+        assert!(io::write(&out.meshes[0], f).is_err(), "{f:?} cannot hold 1e39 either");
+    }
+    for f in [Format::Obj, Format::Ply, Format::Off] {
+        let bytes = io::write(&out.meshes[0], f).expect("written");
+        let back = io::read(&bytes, &ReadOptions::default()).expect("read back").mesh;
+        assert_eq!(back.positions[5][2], 1e39, "{f:?}");
+    }
+    // At the edge of f32 the file is written and reads back finite.
+    mesh.positions[5][2] = 3e38;
+    let bytes = io::write(&mesh, Format::Stl).expect("3e38 fits in f32");
+    assert!(io::read(&bytes, &ReadOptions::default()).is_ok());
+}
