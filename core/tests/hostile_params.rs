@@ -190,3 +190,44 @@ fn morph_duration_outside_f32_keyframe_range_is_a_params_error() {
         assert!(!out.artifacts.is_empty() || !out.meshes.is_empty());
     }
 }
+
+/// Found by the CLI fuzz campaign: valid meshes with parameters that make the implicit system
+/// singular came back as `numerical-failure` (CLI exit 1, "our fault"): mean curvature flow that
+/// collapses the mesh it re-assembles on (an icosahedron with the default 5 steps, homer with
+/// `iterations` 50), `implicit` with `time_step` 1e20, `inflate` with `lambda` 1e308. Each is now
+/// an invalid-params error naming the parameter to change.
+#[test]
+fn parameters_that_make_the_implicit_system_singular_are_named() {
+    let field_of = |mesh: Mesh, params: Value| match run(
+        JobKind::Smooth,
+        vec![mesh],
+        params.clone(),
+        &Progress::new(),
+    ) {
+        Err(Error::InvalidParams { field, message }) => (field, message),
+        Err(e) => panic!("{params}: expected invalid-params, got {}: {e}", e.kind()),
+        Ok(_) => panic!("{params}: expected an error"),
+    };
+    let (field, msg) = field_of(icosphere(0, 1.0), json!({ "method": "mcf" }));
+    assert_eq!(field, "iterations");
+    assert!(msg.contains("collapsed") && msg.contains("of 5") && msg.contains("time_step"), "{msg}");
+    let (field, msg) = field_of(icosphere(2, 1.0), json!({ "method": "implicit", "time_step": 1e20 }));
+    assert_eq!(field, "time_step");
+    assert!(msg.contains("1e20"), "{msg}");
+    let (field, _) = field_of(
+        icosphere(2, 1.0),
+        json!({ "method": "implicit", "time_step": 1e20, "relative_time_step": false }),
+    );
+    assert_eq!(field, "time_step");
+    let (field, _) = field_of(icosphere(2, 1.0), json!({ "method": "inflate", "lambda": 1e308 }));
+    assert_eq!(field, "lambda");
+    // The bound itself is accepted, and an mcf that stops before the collapse still runs.
+    for p in [
+        json!({ "method": "implicit", "time_step": 1e12 }),
+        json!({ "method": "mcf", "iterations": 1 }),
+        json!({ "method": "inflate", "lambda": -1.0 }),
+    ] {
+        let out = run(JobKind::Smooth, vec![icosphere(2, 1.0)], p.clone(), &Progress::new());
+        assert!(out.is_ok(), "{p}: {:?}", out.err());
+    }
+}
