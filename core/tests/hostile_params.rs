@@ -65,6 +65,9 @@ fn smooth_with_hostile_params_never_panics() {
         json!({ "lambda": -1e300 }),
         json!({ "time_step": -1.0 }),
         json!({ "time_step": 0.0 }),
+        // Found by the CLI fuzz campaign: tangential's steps overflowed to infinite positions, the
+        // closest-point query then answered face u32::MAX and the job panicked indexing with it.
+        json!({ "time_step": 1e300 }),
         json!({ "cg_tolerance": 0.0 }),
         json!({ "cg_tolerance": -1.0 }),
         json!({ "order": 0 }),
