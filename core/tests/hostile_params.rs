@@ -234,3 +234,34 @@ fn parameters_that_make_the_implicit_system_singular_are_named() {
         assert!(out.is_ok(), "{p}: {:?}", out.err());
     }
 }
+
+/// Found by the CLI fuzz campaign: `smooth --method inflate --iterations 10000` on suzanne grew
+/// the mesh geometrically to NaN positions and returned them; the writer then refused the output
+/// as "invalid mesh at vertex 0: coordinate is NaN or infinite", blaming the input. The job now
+/// stops at the step that leaves ±1e150 and names `iterations`.
+#[test]
+fn inflation_that_diverges_names_iterations() {
+    let got = run(
+        JobKind::Smooth,
+        vec![icosphere(2, 1.0)],
+        json!({ "method": "inflate", "iterations": 10000 }),
+        &Progress::new(),
+    );
+    match got {
+        Err(Error::InvalidParams { field, message }) => {
+            assert_eq!(field, "iterations");
+            assert!(message.contains("diverged") && message.contains("of 10000"), "{message}");
+        }
+        Err(e) => panic!("expected invalid-params, got {}: {e}", e.kind()),
+        Ok(out) => panic!("expected an error; output check: {:?}", out.meshes[0].check()),
+    }
+    // The few steps the method is meant for still run.
+    let out = run(
+        JobKind::Smooth,
+        vec![icosphere(2, 1.0)],
+        json!({ "method": "inflate", "iterations": 3 }),
+        &Progress::new(),
+    )
+    .expect("3 inflation steps");
+    assert!(out.meshes[0].check().is_ok());
+}

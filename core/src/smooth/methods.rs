@@ -8,7 +8,7 @@ use super::Ctx;
 use crate::error::{Error, Result};
 use crate::geometry::{add, dot, normalize, scale, sub};
 use crate::laplacian::{self, Csr, OperatorKind, PairLayout, Stencil};
-use crate::mesh::Point3;
+use crate::mesh::{Point3, MAX_COORDINATE};
 use crate::solve::SolverChoice;
 use crate::spatial::Bvh;
 
@@ -316,6 +316,20 @@ fn inflate(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
             *p = add(*p, scale(sub(*s, *p), sign));
         }
         ctx.finish_step(x, &before);
+        // Inflation grows geometrically; unchecked, 10,000 steps on suzanne gave NaN positions
+        // that the writer then blamed on the mesh ("invalid mesh at vertex 0").
+        let blown = x.iter().position(|p| p.iter().any(|c| !(c.abs() <= MAX_COORDINATE)));
+        if let Some(v) = blown {
+            return Err(Error::params(
+                "iterations",
+                format!(
+                    "inflation diverged at step {} of {steps}: vertex {v} went beyond ±{MAX_COORDINATE:e} \
+                     (inflating more than 3 steps is unstable, seed 004 §3.4.2); use fewer `iterations` or \
+                     a smaller |lambda|",
+                    it + 1
+                ),
+            ));
+        }
     }
     ctx.solver = sys.stats;
     Ok(())
