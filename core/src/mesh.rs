@@ -271,8 +271,8 @@ impl Mesh {
                 location: Location::Vertex(side.1),
                 message: format!(
                     "the mesh spans only {:e} (the longest side of its bounding box, up to this vertex), \
-                     below {MIN_EXTENT:e}: areas would underflow to 0 and every face would count as \
-                     degenerate; rescale the mesh",
+                     below {MIN_EXTENT:e}: areas and squared distances would underflow to 0 (faces \
+                     would count as degenerate); rescale the mesh",
                     side.0
                 ),
             });
