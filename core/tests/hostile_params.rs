@@ -265,3 +265,17 @@ fn inflation_that_diverges_names_iterations() {
     .expect("3 inflation steps");
     assert!(out.meshes[0].check().is_ok());
 }
+
+/// Found by the CLI fuzz campaign: `smooth woody.obj --method highlight --region-all
+/// --light-spacing 1e-300` ran for more than 40 s: the highlight levels of an edge (distance /
+/// spacing, near 1e300) saturated to i64::MIN..i64::MAX, the count `hi - lo` overflowed past the
+/// per-edge cap, and the node loop never ended. Edges whose levels are beyond exact integers are
+/// now skipped like edges with too many nodes, so the job answers at once.
+#[test]
+fn highlight_with_a_vanishing_light_spacing_answers() {
+    let (cap, _) = meshwork_core::shapes::icosphere_without_cap(3, 60.0);
+    for spacing in [1e-300, 1e-200, 1e-20] {
+        let p = json!({ "method": "highlight", "region_all": true, "light_spacing": spacing });
+        assert_eq!(failure(JobKind::Smooth, vec![cap.clone()], p), None);
+    }
+}
