@@ -191,6 +191,13 @@ pub fn fan_of(f: &[u32], apex: usize, mut emit: impl FnMut([u32; 3])) {
 /// would come out as degenerate faces or empty. 1e150 leaves room for sums of squares.
 pub const MAX_COORDINATE: f64 = 1e150;
 
+/// The smallest extent (longest side of the bounding box) a job accepts when it is not 0
+/// (`convert` excepted). Areas are squared in their norms, so they go as the fourth power of the
+/// edge lengths: below ~1e-77 they underflow to 0 and a valid mesh comes out as degenerate faces
+/// (`repair` emptied a model at 1e-100) or smooths to garbage. 1e-50 leaves room for edges a
+/// million times shorter than the mesh.
+pub const MIN_EXTENT: f64 = 1e-50;
+
 /// A polygon mesh with optional per-vertex attributes, named face groups and polylines.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
@@ -230,8 +237,10 @@ impl Mesh {
     }
 
     /// Refuses coordinates beyond ±[`MAX_COORDINATE`] (finite, but their squares overflow), naming
-    /// the first vertex. A policy on job inputs, not a structural invariant: `job::run` calls it
-    /// for every job but `convert`; readers and [`Mesh::check`] do not.
+    /// the first vertex, and a mesh whose extent is not 0 but below [`MIN_EXTENT`] (its areas
+    /// underflow), naming the vertex at the far end of its longest side. A policy on job inputs,
+    /// not a structural invariant: `job::run` calls it for every job but `convert`; readers and
+    /// [`Mesh::check`] do not.
     pub fn check_coordinate_range(&self) -> Result<()> {
         if let Some(i) = self.positions.iter().position(|p| p.iter().any(|c| c.abs() > MAX_COORDINATE)) {
             let c = self.positions[i].iter().fold(0.0f64, |m, c| m.max(c.abs()));
@@ -240,6 +249,31 @@ impl Mesh {
                 message: format!(
                     "coordinate {c:e} is beyond ±{MAX_COORDINATE:e}: squared lengths and areas would \
                      overflow; rescale the mesh"
+                ),
+            });
+        }
+        // The longest side of the bounding box, and the vertex holding its maximum.
+        let mut side = (0.0f64, 0usize);
+        for k in 0..3 {
+            let (mut lo, mut hi) = (f64::INFINITY, (f64::NEG_INFINITY, 0usize));
+            for (i, p) in self.positions.iter().enumerate() {
+                lo = lo.min(p[k]);
+                if p[k] > hi.0 {
+                    hi = (p[k], i);
+                }
+            }
+            if hi.0 - lo > side.0 {
+                side = (hi.0 - lo, hi.1);
+            }
+        }
+        if side.0 > 0.0 && side.0 < MIN_EXTENT {
+            return Err(Error::InvalidMesh {
+                location: Location::Vertex(side.1),
+                message: format!(
+                    "the mesh spans only {:e} (the longest side of its bounding box, up to this vertex), \
+                     below {MIN_EXTENT:e}: areas and squared distances would underflow to 0 (faces \
+                     would count as degenerate); rescale the mesh",
+                    side.0
                 ),
             });
         }

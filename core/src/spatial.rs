@@ -154,13 +154,17 @@ impl Bvh {
         self.tris.is_empty()
     }
 
-    /// The closest point of the surface to `p` (None for a mesh without faces).
+    /// The closest point of the surface to `p`: None for a mesh without faces, and when no
+    /// distance to `p` is finite (`p` is not finite, or so far away that its squared distance
+    /// overflows), rather than an answer with face `u32::MAX` for callers to index with.
     pub fn closest(&self, p: Point3) -> Option<Closest> {
         if self.tris.is_empty() {
             return None;
         }
         let mut slot = 0;
-        Some(self.closest_search(p, Closest { point: p, face: u32::MAX, dist2: f64::INFINITY }, &mut slot))
+        let best =
+            self.closest_search(p, Closest { point: p, face: u32::MAX, dist2: f64::INFINITY }, &mut slot);
+        (best.face != u32::MAX).then_some(best)
     }
 
     /// [`Bvh::closest`] starting from a guess: `hint` is an index into this BVH's triangles (the

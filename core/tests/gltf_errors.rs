@@ -402,3 +402,38 @@ fn reused_accessors_are_bounded_by_the_limits() {
     let l = read(&glb(&d, &bin.bytes), &ReadOptions::default()).unwrap();
     assert_eq!((l.mesh.vertex_count(), l.mesh.face_count()), (3, 200));
 }
+
+/// Found by the CLI fuzz campaign: a finite node matrix with entries near 1e300 (positions stay
+/// within f64) gave NaN or infinite normals, because the normal matrix's cofactors overflowed;
+/// `meshwork convert` then wrote an OBJ whose `vn` lines our own reader refuses. The matrix is
+/// scaled before its cofactors and determinant: normals come out unit length, and a mirroring
+/// matrix that large still flips the winding.
+#[test]
+fn huge_node_matrix_keeps_normals_finite_and_mirrors() {
+    let read_with = |sx: f64| {
+        let mut bin = Bin::default();
+        let pos = bin.view(&f32s(&FIVE_POINTS[..9]));
+        let nrm = bin.view(&f32s(&[0., 0., 1., 0., 0., 1., 0., 0., 1.]));
+        let d = doc(
+            &bin,
+            json!({
+                "accessors": [vec3_accessor(pos, 3), vec3_accessor(nrm, 3)],
+                "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "NORMAL": 1 } }] }],
+                "nodes": [{ "mesh": 0, "matrix": [sx, 0, 0, 0, 0, 1e300, 0, 0, 0, 0, 1e300, 0, 0, 0, 0, 1] }],
+                "scenes": [{ "nodes": [0] }],
+                "scene": 0
+            }),
+        );
+        read(&glb(&d, &bin.bytes), &ReadOptions::default()).expect("a finite transform is read").mesh
+    };
+    let (plain, mirrored) = (read_with(1e300), read_with(-1e300));
+    for m in [&plain, &mirrored] {
+        assert_eq!(m.positions[1], [m.positions[1][0], 0.0, 0.0]);
+        assert!(m.positions[1][0].abs() == 1e300, "{:?}", m.positions[1]);
+        // A mirror in x maps the normal (0, 0, 1) of a plane z = const to itself.
+        assert_eq!(m.normals.as_ref().expect("normals"), &vec![[0.0, 0.0, 1.0]; 3]);
+    }
+    let (a, b) = (plain.faces.get(0).to_vec(), mirrored.faces.get(0).to_vec());
+    assert_eq!(a, vec![0, 1, 2]);
+    assert_eq!(b, vec![0, 2, 1], "a mirroring transform flips the winding");
+}

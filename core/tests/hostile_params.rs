@@ -65,6 +65,9 @@ fn smooth_with_hostile_params_never_panics() {
         json!({ "lambda": -1e300 }),
         json!({ "time_step": -1.0 }),
         json!({ "time_step": 0.0 }),
+        // Found by the CLI fuzz campaign: tangential's steps overflowed to infinite positions, the
+        // closest-point query then answered face u32::MAX and the job panicked indexing with it.
+        json!({ "time_step": 1e300 }),
         json!({ "cg_tolerance": 0.0 }),
         json!({ "cg_tolerance": -1.0 }),
         json!({ "order": 0 }),
@@ -188,5 +191,91 @@ fn morph_duration_outside_f32_keyframe_range_is_a_params_error() {
         )
         .expect("accepted");
         assert!(!out.artifacts.is_empty() || !out.meshes.is_empty());
+    }
+}
+
+/// Found by the CLI fuzz campaign: valid meshes with parameters that make the implicit system
+/// singular came back as `numerical-failure` (CLI exit 1, "our fault"): mean curvature flow that
+/// collapses the mesh it re-assembles on (an icosahedron with the default 5 steps, homer with
+/// `iterations` 50), `implicit` with `time_step` 1e20, `inflate` with `lambda` 1e308. Each is now
+/// an invalid-params error naming the parameter to change.
+#[test]
+fn parameters_that_make_the_implicit_system_singular_are_named() {
+    let field_of = |mesh: Mesh, params: Value| match run(
+        JobKind::Smooth,
+        vec![mesh],
+        params.clone(),
+        &Progress::new(),
+    ) {
+        Err(Error::InvalidParams { field, message }) => (field, message),
+        Err(e) => panic!("{params}: expected invalid-params, got {}: {e}", e.kind()),
+        Ok(_) => panic!("{params}: expected an error"),
+    };
+    let (field, msg) = field_of(icosphere(0, 1.0), json!({ "method": "mcf" }));
+    assert_eq!(field, "iterations");
+    assert!(msg.contains("collapsed") && msg.contains("of 5") && msg.contains("time_step"), "{msg}");
+    let (field, msg) = field_of(icosphere(2, 1.0), json!({ "method": "implicit", "time_step": 1e20 }));
+    assert_eq!(field, "time_step");
+    assert!(msg.contains("1e20"), "{msg}");
+    let (field, _) = field_of(
+        icosphere(2, 1.0),
+        json!({ "method": "implicit", "time_step": 1e20, "relative_time_step": false }),
+    );
+    assert_eq!(field, "time_step");
+    let (field, _) = field_of(icosphere(2, 1.0), json!({ "method": "inflate", "lambda": 1e308 }));
+    assert_eq!(field, "lambda");
+    // The bound itself is accepted, and an mcf that stops before the collapse still runs.
+    for p in [
+        json!({ "method": "implicit", "time_step": 1e12 }),
+        json!({ "method": "mcf", "iterations": 1 }),
+        json!({ "method": "inflate", "lambda": -1.0 }),
+    ] {
+        let out = run(JobKind::Smooth, vec![icosphere(2, 1.0)], p.clone(), &Progress::new());
+        assert!(out.is_ok(), "{p}: {:?}", out.err());
+    }
+}
+
+/// Found by the CLI fuzz campaign: `smooth --method inflate --iterations 10000` on suzanne grew
+/// the mesh geometrically to NaN positions and returned them; the writer then refused the output
+/// as "invalid mesh at vertex 0: coordinate is NaN or infinite", blaming the input. The job now
+/// stops at the step that leaves ±1e150 and names `iterations`.
+#[test]
+fn inflation_that_diverges_names_iterations() {
+    let got = run(
+        JobKind::Smooth,
+        vec![icosphere(2, 1.0)],
+        json!({ "method": "inflate", "iterations": 10000 }),
+        &Progress::new(),
+    );
+    match got {
+        Err(Error::InvalidParams { field, message }) => {
+            assert_eq!(field, "iterations");
+            assert!(message.contains("diverged") && message.contains("of 10000"), "{message}");
+        }
+        Err(e) => panic!("expected invalid-params, got {}: {e}", e.kind()),
+        Ok(out) => panic!("expected an error; output check: {:?}", out.meshes[0].check()),
+    }
+    // The few steps the method is meant for still run.
+    let out = run(
+        JobKind::Smooth,
+        vec![icosphere(2, 1.0)],
+        json!({ "method": "inflate", "iterations": 3 }),
+        &Progress::new(),
+    )
+    .expect("3 inflation steps");
+    assert!(out.meshes[0].check().is_ok());
+}
+
+/// Found by the CLI fuzz campaign: `smooth woody.obj --method highlight --region-all
+/// --light-spacing 1e-300` ran for more than 40 s: the highlight levels of an edge (distance /
+/// spacing, near 1e300) saturated to i64::MIN..i64::MAX, the count `hi - lo` overflowed past the
+/// per-edge cap, and the node loop never ended. Edges whose levels are beyond exact integers are
+/// now skipped like edges with too many nodes, so the job answers at once.
+#[test]
+fn highlight_with_a_vanishing_light_spacing_answers() {
+    let (cap, _) = meshwork_core::shapes::icosphere_without_cap(3, 60.0);
+    for spacing in [1e-300, 1e-200, 1e-20] {
+        let p = json!({ "method": "highlight", "region_all": true, "light_spacing": spacing });
+        assert_eq!(failure(JobKind::Smooth, vec![cap.clone()], p), None);
     }
 }

@@ -307,3 +307,72 @@ fn coordinates_whose_squares_overflow_are_refused_by_jobs_from_every_format() {
     let mesh = io::read(ok.as_bytes(), &ReadOptions::default()).unwrap().mesh;
     assert!(run(JobKind::Repair, vec![mesh], json!({}), &Progress::new()).is_ok());
 }
+
+/// Found by the CLI fuzz campaign: the mirror of the case above. Suzanne scaled by 1e-100 is a valid
+/// mesh, but the norms of its face normals square squared lengths and underflow to 0, so `repair`
+/// dropped every face as zero-area and wrote an empty mesh (exit 0), `info` called all 500 faces
+/// degenerate, and `tangential` moved vertices by twice the model's size at 1e-80. Every job but
+/// `convert` refuses an extent below 1e-50, naming a vertex; 1e-40 still works as at scale 1.
+#[test]
+fn extents_whose_areas_underflow_are_refused_by_every_job_but_convert() {
+    let tiny = scaled(icosphere(2, 1.0), 1e-100);
+    for (kind, params) in single_mesh_jobs() {
+        if kind == JobKind::Convert {
+            let out = run(kind, vec![tiny.clone()], params, &Progress::new()).expect("convert");
+            assert_eq!(out.meshes[0].positions, tiny.positions, "convert keeps the numbers");
+            continue;
+        }
+        let e = run(kind, vec![tiny.clone()], params.clone(), &Progress::new())
+            .expect_err(&format!("{} {params} must refuse an extent of 2e-100", kind.name()));
+        let msg = e.to_string();
+        assert!(matches!(e, Error::InvalidMesh { .. }), "{} {params}: {msg}", kind.name());
+        assert!(msg.contains("vertex") && msg.contains("rescale") && msg.contains("1e-50"), "{msg}");
+    }
+    let e = run(
+        JobKind::Fit,
+        vec![icosphere(2, 1.0), scaled(icosphere(1, 1.0), 1e-100)],
+        json!({}),
+        &Progress::new(),
+    )
+    .expect_err("fit refuses tiny curves too");
+    assert!(matches!(e, Error::InvalidMesh { .. }), "{e}");
+    // Small but above the bound: repair keeps every face, as at scale 1.
+    let small = scaled(icosphere(2, 1.0), 1e-40);
+    let faces = small.face_count();
+    let out = run(JobKind::Repair, vec![small], json!({}), &Progress::new()).expect("repair at 1e-40");
+    assert_eq!(out.meshes[0].face_count(), faces);
+    // All points coincident (extent 0) is not a scale problem: still answered as before.
+    let point = tris(vec![[0.5; 3]; 4], &[[0, 1, 2], [0, 2, 3]]);
+    assert!(run(JobKind::Repair, vec![point], json!({}), &Progress::new()).is_ok());
+}
+
+/// Found by the CLI fuzz campaign: `meshwork convert` of a valid mesh with coordinates near 1e149
+/// (inside the ±1e150 every job accepts) to `.stl` exited 0 and wrote infinities, because binary
+/// STL stores f32: the file was refused by our own reader ("coordinate is NaN or infinite"). The
+/// STL writer now refuses, naming the vertex, as the GLB writer did; OBJ, PLY and OFF keep it.
+#[test]
+fn stl_output_refuses_coordinates_beyond_f32_naming_the_vertex() {
+    use meshwork_core::io::{self, Format, ReadOptions};
+    let mut mesh = icosphere(1, 1.0);
+    mesh.positions[5][2] = 1e39;
+    let out = run(JobKind::Convert, vec![mesh.clone()], json!({}), &Progress::new()).expect("convert");
+    let e = io::write(&out.meshes[0], Format::Stl).expect_err("STL cannot hold 1e39");
+    let msg = e.to_string();
+    assert!(
+        matches!(e, Error::InvalidMesh { location: meshwork_core::error::Location::Vertex(5), .. }),
+        "{msg}"
+    );
+    assert!(msg.contains("1e39") && msg.contains("f32"), "{msg}");
+    for f in [Format::Glb, Format::Gltf] {
+        assert!(io::write(&out.meshes[0], f).is_err(), "{f:?} cannot hold 1e39 either");
+    }
+    for f in [Format::Obj, Format::Ply, Format::Off] {
+        let bytes = io::write(&out.meshes[0], f).expect("written");
+        let back = io::read(&bytes, &ReadOptions::default()).expect("read back").mesh;
+        assert_eq!(back.positions[5][2], 1e39, "{f:?}");
+    }
+    // At the edge of f32 the file is written and reads back finite.
+    mesh.positions[5][2] = 3e38;
+    let bytes = io::write(&mesh, Format::Stl).expect("3e38 fits in f32");
+    assert!(io::read(&bytes, &ReadOptions::default()).is_ok());
+}

@@ -107,7 +107,13 @@ pub fn run_job(kind: JobKind, args: JobArgs, extra: Map<String, Value>) -> Resul
         if !(t.is_finite() && t >= 0.0) {
             return Err(Failure::usage("error[usage]: --timeout must be a non-negative number of seconds"));
         }
-        progress.set_deadline(Instant::now() + Duration::from_secs_f64(t));
+        // A timeout too long for a Duration or an Instant (`--timeout 1e300` panicked here) would
+        // never fire anyway: no deadline.
+        if let Some(deadline) =
+            Duration::try_from_secs_f64(t).ok().and_then(|d| Instant::now().checked_add(d))
+        {
+            progress.set_deadline(deadline);
+        }
     }
     let show = !args.quiet && std::io::stderr().is_terminal();
     if show {

@@ -131,8 +131,10 @@ impl Config {
             ("result_ttl_secs", self.result_ttl_secs),
             ("shutdown_grace_secs", self.shutdown_grace_secs),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} must be a non-negative number of seconds, got {v}"));
+            // Bounded so that a Duration and an Instant can hold it: `--job-timeout 1e300` failed
+            // every job with a panic, `--result-ttl`/`--shutdown-grace 1e300` the start-up.
+            if !(v.is_finite() && v >= 0.0 && v <= MAX_SECS) {
+                return Err(format!("{name} must be a number of seconds in [0, {MAX_SECS:e}], got {v}"));
             }
         }
         Ok(())
@@ -143,6 +145,9 @@ impl Config {
         self.workers + self.queue
     }
 }
+
+/// The longest time setting accepted (about 31 years).
+const MAX_SECS: f64 = 1e9;
 
 fn set<T>(slot: &mut T, v: Option<T>) {
     if let Some(v) = v {
@@ -189,5 +194,25 @@ mod tests {
         std::fs::write(&f, "queu = 3\n").unwrap();
         let e = Config::load(&ServeArgs { config: Some(f), ..Default::default() }).unwrap_err();
         assert!(e.contains("queu"), "{e}");
+    }
+
+    /// Found by the CLI fuzz campaign: `serve --job-timeout 1e300` answered every job with a 500
+    /// (the handler panicked converting it to a Duration), `--result-ttl 1e300` and
+    /// `--shutdown-grace 1e300` panicked at start-up (exit 101). They are now refused by name.
+    #[test]
+    fn times_too_long_to_represent_are_refused_by_name() {
+        let base = ServeArgs { port: Some(0), ..Default::default() };
+        for (args, name) in [
+            (ServeArgs { job_timeout: Some(1e300), ..base.clone() }, "job_timeout_secs"),
+            (ServeArgs { result_ttl: Some(1e300), ..base.clone() }, "result_ttl_secs"),
+            (ServeArgs { shutdown_grace: Some(1e300), ..base.clone() }, "shutdown_grace_secs"),
+        ] {
+            let e = Config::load(&args).unwrap_err();
+            assert!(e.contains(name) && e.contains("1e9"), "{e}");
+        }
+        let c = Config::load(&ServeArgs { job_timeout: Some(1e9), ..base }).unwrap();
+        assert!(std::time::Instant::now()
+            .checked_add(std::time::Duration::from_secs_f64(c.job_timeout_secs))
+            .is_some());
     }
 }

@@ -113,6 +113,30 @@ fn bad_input_and_params_exit_2_with_kind_and_location() {
     assert_clean(&o);
 }
 
+/// Found by the CLI fuzz campaign: `--timeout 1e300` panicked (exit 101, "cannot convert float
+/// seconds to Duration"); a timeout too long to represent now means no deadline.
+#[test]
+fn huge_timeout_means_no_deadline() {
+    let good = tmp("timeout-good.obj");
+    std::fs::write(&good, TETRA_OBJ).unwrap();
+    for t in ["1e300", "9e18", "1e6"] {
+        let out = tmp(&format!("timeout-{t}.obj"));
+        let o = run(&["convert", good.to_str().unwrap(), "-o", out.to_str().unwrap(), "--timeout", t]);
+        assert_clean(&o);
+        assert!(o.status.success(), "--timeout {t}: {}", stderr(&o));
+        assert!(out.exists(), "--timeout {t}");
+    }
+    let o = run(&[
+        "convert",
+        good.to_str().unwrap(),
+        "-o",
+        tmp("timeout-nan.obj").to_str().unwrap(),
+        "--timeout",
+        "nan",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
 #[test]
 fn piped_run_prints_no_progress_line() {
     let good = tmp("quiet.obj");

@@ -328,8 +328,21 @@ pub fn write(mesh: &Mesh) -> Result<Vec<u8>> {
     header[..text.len()].copy_from_slice(text);
     out.extend_from_slice(&header);
     out.extend_from_slice(&ntri32.to_le_bytes());
-    for tri in mesh.faces.triangles() {
-        let tri = tri.map(|i| mesh.positions[i as usize]);
+    for idx in mesh.faces.triangles() {
+        // A coordinate beyond f32's range would be written as infinity, a file no reader accepts.
+        for i in idx {
+            if let Some(&c) = mesh.positions[i as usize].iter().find(|c| !(**c as f32).is_finite()) {
+                return Err(Error::InvalidMesh {
+                    location: Location::Vertex(i as usize),
+                    message: format!(
+                        "coordinate {c:e} is beyond binary STL's f32 range (±{:e}); write OBJ, PLY or OFF \
+                         to keep it, or rescale the mesh",
+                        f32::MAX
+                    ),
+                });
+            }
+        }
+        let tri = idx.map(|i| mesh.positions[i as usize]);
         let n = geometry::normalize(geometry::triangle_cross(tri[0], tri[1], tri[2]));
         for v in std::iter::once(n).chain(tri) {
             for c in v {

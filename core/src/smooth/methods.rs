@@ -8,7 +8,7 @@ use super::Ctx;
 use crate::error::{Error, Result};
 use crate::geometry::{add, dot, normalize, scale, sub};
 use crate::laplacian::{self, Csr, OperatorKind, PairLayout, Stencil};
-use crate::mesh::Point3;
+use crate::mesh::{Point3, MAX_COORDINATE};
 use crate::solve::SolverChoice;
 use crate::spatial::Bvh;
 
@@ -244,7 +244,7 @@ fn boundary_curve_step(ctx: &Ctx, x: &mut [Point3], h: f64) -> Result<()> {
 }
 
 fn implicit(ctx: &mut Ctx, x: &mut Vec<Point3>, reassemble: bool) -> Result<()> {
-    let h = ctx.effective_step(ctx.r.time_step);
+    let h = ctx.implicit_step("time_step", ctx.r.time_step)?;
     let moving = interior_moving(ctx);
     let d = weighted_scale(ctx, &ctx.op.scale);
     let steps = ctx.r.iterations as usize;
@@ -263,7 +263,23 @@ fn implicit(ctx: &mut Ctx, x: &mut Vec<Point3>, reassemble: bool) -> Result<()> 
             boundary_curve_step(ctx, x, h)?;
         }
         let b: Vec<Point3> = x.iter().zip(&d).map(|(p, &d)| scale(*p, d)).collect();
-        sys.solve(&b, x, ctx.progress)?;
+        match sys.solve(&b, x, ctx.progress) {
+            // The operator was assembled on the flow's own output: mean curvature flow pinches thin
+            // parts and shrinks closed meshes to a point, and the collapsed faces make the system
+            // singular. That is what the parameters asked of this mesh, not a failure on our side.
+            Err(Error::Numerical { message, .. }) if reassemble && it > 0 => {
+                return Err(Error::params(
+                    "iterations",
+                    format!(
+                        "mean curvature flow collapsed parts of the mesh at step {} of {steps} (the \
+                         re-assembled system is singular: {message}); use fewer `iterations` or a \
+                         smaller `time_step`",
+                        it + 1
+                    ),
+                ));
+            }
+            r => r?,
+        }
         ctx.finish_step(x, &before);
     }
     ctx.solver = sys.stats;
@@ -280,7 +296,7 @@ fn inflate(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
     if ctx.r.iterations > 3 && lambda < 0.0 {
         ctx.warnings.push("inflation with more than 3 iterations is unstable (seed 004 §3.4.2)".into());
     }
-    let h = ctx.effective_step(lambda.abs());
+    let h = ctx.implicit_step("lambda", lambda.abs())?;
     let moving = interior_moving(ctx);
     let d = weighted_scale(ctx, &ctx.op.scale);
     let steps = ctx.r.iterations as usize;
@@ -300,6 +316,20 @@ fn inflate(ctx: &mut Ctx, x: &mut Vec<Point3>) -> Result<()> {
             *p = add(*p, scale(sub(*s, *p), sign));
         }
         ctx.finish_step(x, &before);
+        // Inflation grows geometrically; unchecked, 10,000 steps on suzanne gave NaN positions
+        // that the writer then blamed on the mesh ("invalid mesh at vertex 0").
+        let blown = x.iter().position(|p| p.iter().any(|c| !(c.abs() <= MAX_COORDINATE)));
+        if let Some(v) = blown {
+            return Err(Error::params(
+                "iterations",
+                format!(
+                    "inflation diverged at step {} of {steps}: vertex {v} went beyond ±{MAX_COORDINATE:e} \
+                     (inflating more than 3 steps is unstable, seed 004 §3.4.2); use fewer `iterations` or \
+                     a smaller |lambda|",
+                    it + 1
+                ),
+            ));
+        }
     }
     ctx.solver = sys.stats;
     Ok(())

@@ -42,6 +42,12 @@ pub(crate) struct Ctx<'a> {
     pub warnings: Vec<String>,
 }
 
+/// The largest implicit step, in mean edge lengths squared for the area-scaled operators (in the
+/// operator's own units for the others): beyond it the mass term `D/h` of `D/h + S` is lost in the
+/// round-off of `S`, whose rows sum to 0, and the Cholesky fails (homer with `time_step` 1e20,
+/// suzanne with `inflate` `lambda` 1e308); every component has long reached its centroid anyway.
+pub const MAX_RELATIVE_STEP: f64 = 1e12;
+
 impl Ctx<'_> {
     /// The time step in the units of the operator (see `SmoothParams::time_step`).
     pub fn effective_step(&self, h: f64) -> f64 {
@@ -50,6 +56,30 @@ impl Ctx<'_> {
         } else {
             h
         }
+    }
+
+    /// [`Ctx::effective_step`] of the implicit methods, refused by parameter name when it is
+    /// beyond [`MAX_RELATIVE_STEP`].
+    pub fn implicit_step(&self, field: &str, h: f64) -> Result<f64> {
+        let step = self.effective_step(h);
+        let area_scaled = self.r.operator.area_scaled();
+        let unit = self.edge_len * self.edge_len;
+        let (relative, units) = match (area_scaled, self.r.relative_time_step) {
+            (true, true) => (h, " mean edge lengths squared"),
+            (true, false) => (if unit > 0.0 { step / unit } else { 0.0 }, " mean edge lengths squared"),
+            (false, _) => (step, ""),
+        };
+        if !(relative <= MAX_RELATIVE_STEP) {
+            return Err(Error::params(
+                field,
+                format!(
+                    "the implicit step is {relative:e}{units}, beyond {MAX_RELATIVE_STEP:e}: its system \
+                     is numerically singular (every component would collapse to its centroid); use a \
+                     smaller value"
+                ),
+            ));
+        }
+        Ok(step)
     }
 
     /// Applies the axis mask and volume preservation after a step from `before`.

@@ -78,6 +78,15 @@ case("nan-coordinate-binary", "invalid-mesh", f"byte-{len(h) + 12}", "ply", h + 
 h = ply_header("binary_big_endian", 3, 1)
 be = struct.pack(">9f", 0, 0, 0, 1, 0, 0, 0, float("inf"), 0) + struct.pack(">B3i", 3, 0, 1, 2)
 case("inf-coordinate-big-endian", "invalid-mesh", f"byte-{len(h) + 24}", "ply", h + be)
+# Found by the CLI fuzz campaign: NaN/inf in a normal or a texture coordinate was read, and
+# `convert` then wrote an OBJ whose `vn` our own OBJ reader refuses. Located at the vertex.
+h = ply_header("binary_little_endian", 3, 1, vprops="property float x\nproperty float y\nproperty float z\n"
+               "property float nx\nproperty float ny\nproperty float nz\n")
+nb = struct.pack("<18f", 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, float("nan"), 1, 0, 1, 0, 0, 0, 1) + struct.pack("<B3i", 3, 0, 1, 2)
+case("nan-normal-binary", "invalid-mesh", f"byte-{len(h) + 24}", "ply", h + nb)
+case("inf-texture-coordinate-ascii", "invalid-mesh", "line-13", "ply",
+     ply_header("ascii", 3, 1, vprops="property float x\nproperty float y\nproperty float z\n"
+                "property float s\nproperty float t\n") + b"0 0 0 0 0\n1 0 0 inf 0\n0 1 0 0 1\n3 0 1 2\n")
 # A list count of 255 on a 3-vertex face: the data ends before 255 ints. Located at the count byte.
 h = ply_header("binary_little_endian", 3, 1)
 case("list-count-beyond-data", "malformed-input", f"byte-{len(h) + 36}", "ply",

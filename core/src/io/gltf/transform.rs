@@ -58,17 +58,30 @@ pub(super) fn apply_point(m: &Mat4, p: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// Determinant of the upper 3×3 (negative: the transform mirrors, so winding must flip).
+/// The upper 3×3 divided by its largest magnitude (a positive factor: same determinant sign,
+/// same normal directions). Cofactors and the determinant multiply two or three entries, which
+/// overflow to NaN for a finite transform with entries near 1e300 (its normals came out NaN).
+fn upper3_scaled(m: &Mat4) -> Mat4 {
+    let big = [0, 1, 2, 4, 5, 6, 8, 9, 10].iter().map(|&i| m[i].abs()).fold(0.0f64, f64::max);
+    let s = if big > 0.0 && big.is_finite() { 1.0 / big } else { 1.0 };
+    m.map(|v| v * s)
+}
+
+/// Sign of the determinant of the upper 3×3 (negative: the transform mirrors, so winding must
+/// flip), from the scaled matrix so that it does not overflow.
 pub(super) fn det3(m: &Mat4) -> f64 {
+    let m = upper3_scaled(m);
     m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2])
         + m[8] * (m[1] * m[6] - m[5] * m[2])
 }
 
 /// Matrix that maps normals: the cofactor matrix of the upper 3×3 (= det · inverse-transpose),
-/// sign-corrected so mirrored transforms keep normals pointing the right way. Callers normalise.
+/// sign-corrected so mirrored transforms keep normals pointing the right way, up to a positive
+/// factor (the matrix is scaled first, see [`upper3_scaled`]). Callers normalise.
 pub(super) fn normal_matrix(m: &Mat4) -> [[f64; 3]; 3] {
-    let a = |r: usize, c: usize| m[c * 4 + r];
     let sign = if det3(m) < 0.0 { -1.0 } else { 1.0 };
+    let m = upper3_scaled(m);
+    let a = |r: usize, c: usize| m[c * 4 + r];
     let mut n = [[0.0; 3]; 3];
     for (r, row) in n.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {

@@ -143,10 +143,21 @@ fn read_vertices(el: &Element, body: &mut dyn Body, out: &mut Out) -> Result<()>
                 _ => body.skip(prop.ty, 1)?,
             }
         }
-        if !p.iter().all(|c| c.is_finite()) {
+        // Normals and texture coordinates too, as the OBJ, OFF and glTF readers do: a NaN normal
+        // was read and then written to an OBJ that no reader accepts.
+        let bad = if !p.iter().all(|c| c.is_finite()) {
+            Some("coordinate")
+        } else if has_n && !n.iter().all(|c| c.is_finite()) {
+            Some("normal")
+        } else if has_uv && !uv.iter().all(|c| c.is_finite()) {
+            Some("texture coordinate")
+        } else {
+            None
+        };
+        if let Some(what) = bad {
             return Err(Error::InvalidMesh {
                 location: at,
-                message: format!("vertex {i}: coordinate is NaN or infinite"),
+                message: format!("vertex {i}: {what} is NaN or infinite"),
             });
         }
         out.positions.push(p);

@@ -219,6 +219,13 @@ pub fn model(adj: &Adjacency, x: &[Point3], lights: &Lights) -> Model {
             continue;
         }
         let (ua, ub) = (da / s, db / s);
+        // Levels beyond 2^53 are not exact integers, and near i64's range `hi - lo` and `lo + 1`
+        // overflow (a spacing of 1e-300 looped for ever): such an edge has far more than
+        // `MAX_NODES_PER_EDGE` nodes anyway.
+        if !(ua.abs() < 9.0e15 && ub.abs() < 9.0e15) {
+            skipped += 1;
+            continue;
+        }
         // Levels m with exactly one end "≥ m": lo < m ≤ hi.
         let (lo, hi) = (ua.min(ub).floor() as i64, ua.max(ub).floor() as i64);
         if hi - lo > MAX_NODES_PER_EDGE {
