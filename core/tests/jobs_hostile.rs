@@ -302,8 +302,9 @@ fn coordinates_whose_squares_overflow_are_refused_by_jobs_from_every_format() {
             );
         }
     }
-    // The bound itself is accepted.
-    let ok = "v 0 0 0\nv 1 0 0\nv 0 1e150 0\nf 1 2 3\n";
+    // The bound itself is accepted (a right triangle with legs of 1e150: one of 1 by 1e150 is a
+    // needle the repair removes, and a repair that removes every face is refused).
+    let ok = "v 0 0 0\nv 1e150 0 0\nv 0 1e150 0\nf 1 2 3\n";
     let mesh = io::read(ok.as_bytes(), &ReadOptions::default()).unwrap().mesh;
     assert!(run(JobKind::Repair, vec![mesh], json!({}), &Progress::new()).is_ok());
 }
@@ -341,9 +342,11 @@ fn extents_whose_areas_underflow_are_refused_by_every_job_but_convert() {
     let faces = small.face_count();
     let out = run(JobKind::Repair, vec![small], json!({}), &Progress::new()).expect("repair at 1e-40");
     assert_eq!(out.meshes[0].face_count(), faces);
-    // All points coincident (extent 0) is not a scale problem: still answered as before.
+    // All points coincident (extent 0) is not a scale problem: the repair's own answer (it removes
+    // both faces, which it refuses to return as an empty mesh), not the extent's refusal.
     let point = tris(vec![[0.5; 3]; 4], &[[0, 1, 2], [0, 2, 3]]);
-    assert!(run(JobKind::Repair, vec![point], json!({}), &Progress::new()).is_ok());
+    let e = run(JobKind::Repair, vec![point], json!({}), &Progress::new()).expect_err("nothing left");
+    assert!(!e.to_string().contains("rescale") && e.to_string().contains("every face of the mesh"), "{e}");
 }
 
 /// Found by the CLI fuzz campaign: `meshwork convert` of a valid mesh with coordinates near 1e149
@@ -375,4 +378,28 @@ fn stl_output_refuses_coordinates_beyond_f32_naming_the_vertex() {
     mesh.positions[5][2] = 3e38;
     let bytes = io::write(&mesh, Format::Stl).expect("3e38 fits in f32");
     assert!(io::read(&bytes, &ReadOptions::default()).is_ok());
+}
+
+/// A repair that removes every face answers with the reason, not an empty mesh (an empty OBJ, PLY
+/// or OFF is not readable as a mesh, and an empty GLB says nothing): found by fuzzing (session 20),
+/// the collinear and coincident meshes gave exit 0 and an empty file. Truth by hand: the collinear
+/// triangle has zero area; the coincident mesh's two faces have one distinct vertex each.
+#[test]
+fn a_repair_that_removes_every_face_says_so_by_step() {
+    let cases = [
+        ("collinear triangle", tris(vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[[0, 1, 2]]), 1),
+        ("all points coincident", tris(vec![[0.5; 3]; 4], &[[0, 1, 2], [0, 2, 3]]), 2),
+    ];
+    for (name, mesh, faces) in cases {
+        let e = run(JobKind::Repair, vec![mesh], json!({}), &Progress::new()).expect_err(name);
+        let text = e.to_string();
+        assert!(matches!(e, Error::InvalidMesh { .. }), "{name}: {e:?}");
+        assert!(text.contains(&format!("every face of the mesh ({faces} in all")), "{name}: {text}");
+        assert!(text.contains("clean.dropped_"), "{name}: the step that removed them: {text}");
+    }
+    // One good face left is an answer.
+    let sq = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0]];
+    let out = run(JobKind::Repair, vec![tris(sq, &[[0, 1, 2], [0, 1, 3]])], json!({}), &Progress::new())
+        .expect("a repair that keeps a face");
+    assert_eq!(out.meshes[0].face_count(), 1);
 }

@@ -26,7 +26,7 @@ pub mod weld;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Location, Result};
 use crate::job::{Output, Progress, Stages};
 use crate::mesh::{Mesh, Point3};
 use crate::topology::NONE;
@@ -198,6 +198,7 @@ pub fn run(mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Out
     };
     mend_topology(&mut r, params, &input)?;
     close_and_compact(&mut r, params, &input)?;
+    refuse_if_emptied(&r, input.faces)?;
 
     let out = if r.dirty {
         let mesh = &r.mesh;
@@ -211,6 +212,31 @@ pub fn run(mesh: Mesh, params: &RepairParams, progress: &Progress) -> Result<Out
     }
     let report = job_report(&r, &input, &out, why, params.report_vertex_map);
     Ok(Output { meshes: vec![r.mesh], report, ..Default::default() })
+}
+
+/// Refuses a repair that removed every one of the input's `faces`: an empty mesh is no answer
+/// (OBJ, PLY and OFF files of it are not even readable as meshes), so the caller gets the reason,
+/// each step's removals by name, instead of a file with nothing in it.
+fn refuse_if_emptied(r: &Repairing, faces: usize) -> Result<()> {
+    if faces == 0 || r.mesh.face_count() > 0 {
+        return Ok(());
+    }
+    let mut removed = Vec::new();
+    for (step, report) in &r.steps {
+        for (field, n) in report.as_object().into_iter().flatten() {
+            let is_removal = field.starts_with("dropped_") || field == "faces_removed";
+            if let Some(n) = n.as_u64().filter(|&n| is_removal && n > 0) {
+                removed.push(format!("{step}.{field} {n}"));
+            }
+        }
+    }
+    Err(Error::InvalidMesh {
+        location: Location::Face(0),
+        message: format!(
+            "the repair removed every face of the mesh ({faces} in all; {}): nothing is left to return",
+            if removed.is_empty() { "no step names them".to_string() } else { removed.join(", ") }
+        ),
+    })
 }
 
 /// The repair in progress: the mesh, the timings, each step's report (or why it was skipped),
