@@ -236,6 +236,25 @@ impl Mesh {
         self.groups.get(id as usize).map(String::as_str).unwrap_or("")
     }
 
+    /// The longest side of the bounding box (0 for no or one distinct position), and the vertex
+    /// holding its maximum.
+    pub fn longest_side(&self) -> (f64, usize) {
+        let mut side = (0.0f64, 0usize);
+        for k in 0..3 {
+            let (mut lo, mut hi) = (f64::INFINITY, (f64::NEG_INFINITY, 0usize));
+            for (i, p) in self.positions.iter().enumerate() {
+                lo = lo.min(p[k]);
+                if p[k] > hi.0 {
+                    hi = (p[k], i);
+                }
+            }
+            if hi.0 - lo > side.0 {
+                side = (hi.0 - lo, hi.1);
+            }
+        }
+        side
+    }
+
     /// Refuses coordinates beyond ±[`MAX_COORDINATE`] (finite, but their squares overflow), naming
     /// the first vertex, and a mesh whose extent is not 0 but below [`MIN_EXTENT`] (its areas
     /// underflow), naming the vertex at the far end of its longest side. A policy on job inputs,
@@ -252,20 +271,7 @@ impl Mesh {
                 ),
             });
         }
-        // The longest side of the bounding box, and the vertex holding its maximum.
-        let mut side = (0.0f64, 0usize);
-        for k in 0..3 {
-            let (mut lo, mut hi) = (f64::INFINITY, (f64::NEG_INFINITY, 0usize));
-            for (i, p) in self.positions.iter().enumerate() {
-                lo = lo.min(p[k]);
-                if p[k] > hi.0 {
-                    hi = (p[k], i);
-                }
-            }
-            if hi.0 - lo > side.0 {
-                side = (hi.0 - lo, hi.1);
-            }
-        }
+        let side = self.longest_side();
         if side.0 > 0.0 && side.0 < MIN_EXTENT {
             return Err(Error::InvalidMesh {
                 location: Location::Vertex(side.1),

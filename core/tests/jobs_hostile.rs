@@ -380,6 +380,39 @@ fn stl_output_refuses_coordinates_beyond_f32_naming_the_vertex() {
     assert!(io::read(&bytes, &ReadOptions::default()).is_ok());
 }
 
+/// The other end of f32 (fuzzing, session 20): `convert` (exempt from the jobs' 1e-50 extent rule)
+/// of a mesh at 1e-300 wrote a GLB of zeros, exit 0. glTF and STL now refuse an extent below
+/// `io::F32_MIN_EXTENT` (1e-30), naming the vertex at the far end of the longest side; OBJ, PLY and
+/// OFF keep the numbers. By hand: an icosphere of radius 1 spans 2 along each axis, so 1e-31 and
+/// 1e-300 scales give extents 2e-31 and 2e-300, below the bound, and 1e-29 gives 2e-29, above it.
+#[test]
+fn f32_output_refuses_a_mesh_too_small_for_f32() {
+    use meshwork_core::io::{self, Format, ReadOptions};
+    for s in [1e-31, 1e-300] {
+        let tiny = scaled(icosphere(1, 1.0), s);
+        let out = run(JobKind::Convert, vec![tiny.clone()], json!({}), &Progress::new()).expect("convert");
+        for f in [Format::Glb, Format::Gltf, Format::Stl] {
+            let e = io::write(&out.meshes[0], f).expect_err("f32 cannot hold it");
+            let msg = e.to_string();
+            assert!(matches!(e, Error::InvalidMesh { .. }), "{f:?}: {msg}");
+            assert!(msg.contains("vertex") && msg.contains("f32") && msg.contains("1e-30"), "{f:?}: {msg}");
+        }
+        for f in [Format::Obj, Format::Ply, Format::Off] {
+            let bytes = io::write(&out.meshes[0], f).expect("written");
+            let back = io::read(&bytes, &ReadOptions::default()).expect("read back").mesh;
+            assert_eq!(back.positions, tiny.positions, "{f:?} at {s:e}");
+        }
+    }
+    // Above the bound: written, and the positions read back are not flushed (not all equal).
+    let small = scaled(icosphere(1, 1.0), 1e-29);
+    for f in [Format::Glb, Format::Stl] {
+        let bytes = io::write(&small, f).expect("1e-29 fits");
+        let back = io::read(&bytes, &ReadOptions::default()).expect("read back").mesh;
+        let first = back.positions[0];
+        assert!(back.positions.iter().any(|p| *p != first), "{f:?}: collapsed");
+    }
+}
+
 /// A repair that removes every face answers with the reason, not an empty mesh (an empty OBJ, PLY
 /// or OFF is not readable as a mesh, and an empty GLB says nothing): found by fuzzing (session 20),
 /// the collinear and coincident meshes gave exit 0 and an empty file. Truth by hand: the collinear

@@ -172,8 +172,28 @@ fn detect_content(bytes: &[u8]) -> Option<Format> {
     None
 }
 
+/// The smallest extent (longest side of the bounding box) written in f32 (glTF, binary STL) when
+/// it is not 0: below it the coordinates, and details a ten-millionth of the mesh, leave f32's
+/// normal range (≈1.2e-38) and are written as a few bits or 0 (fuzzing, session 20: `convert` of
+/// a mesh at 1e-300 wrote a GLB of zeros, exit 0).
+pub const F32_MIN_EXTENT: f64 = 1e-30;
+
 /// Writes a mesh in the given format.
 pub fn write(mesh: &Mesh, format: Format) -> Result<Vec<u8>> {
+    if matches!(format, Format::Glb | Format::Gltf | Format::Stl) {
+        let (side, v) = mesh.longest_side();
+        if side > 0.0 && side < F32_MIN_EXTENT {
+            return Err(Error::InvalidMesh {
+                location: Location::Vertex(v),
+                message: format!(
+                    "the mesh spans only {side:e} (the longest side of its bounding box, up to this vertex), \
+                     below {F32_MIN_EXTENT:e}: {} stores f32 coordinates, which would flush it to 0; write OBJ, \
+                     PLY or OFF to keep it, or rescale the mesh",
+                    format.extension().to_uppercase()
+                ),
+            });
+        }
+    }
     match format {
         Format::Obj => obj::write(mesh),
         Format::Glb => gltf::write_glb(mesh),
