@@ -470,6 +470,14 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             mesh.pos.len()
         )));
     }
+    // Faces standing steeply against the count's reference (fins of three consecutive section
+    // points, faces on edge after smoothing) are flipped flat first where that adds no folded
+    // edge: the last repair cannot turn a fin the count calls turned when the fin across the
+    // curve folds against it (session 20).
+    let steep_flips = stages.run(progress, "steep_faces", || {
+        orientation.cache_faces(&mesh.tris, progress)?;
+        untangle::flip_steep(&mut mesh, &orientation, &curve_edges, progress)
+    })?;
     let turned = stages.run(progress, "turned_faces", || {
         let mut fixed_now = fixed.clone();
         fixed_now.resize(mesh.pos.len(), true);
@@ -669,6 +677,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         "limit": params.max_face_growth,
     });
     report["turned_faces"] = serde_json::to_value(&turned).unwrap_or_default();
+    report["steep_faces_flipped"] = steep_flips.into();
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })

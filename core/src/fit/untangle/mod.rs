@@ -29,6 +29,7 @@ pub(crate) mod flip_search;
 mod folds;
 mod kernel;
 mod patch;
+mod steep;
 
 pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
 pub(crate) use kernel::{kernel_centre, RingFrame};
@@ -203,6 +204,17 @@ pub(crate) fn guarded_flip_sequences(
     let ctx = Ctx { reference, fixed, locked };
     let pass = flip_search::flip_sequences(mesh, &ctx, Some(guard), bad, progress)?;
     Ok((pass.regions, pass.flips))
+}
+
+/// Flips non-locked edges of faces standing steeply on the surface ([`steep`]); returns the flips.
+pub fn flip_steep(
+    mesh: &mut TriMesh,
+    reference: &dyn Reference,
+    locked: &EdgeSet,
+    progress: &Progress,
+) -> Result<usize> {
+    let ctx = Ctx { reference, fixed: &[], locked };
+    steep::flip_steep(mesh, &ctx, progress)
 }
 
 /// The live folded faces in id order, polling every [`POLL_FACES`] face ids.
