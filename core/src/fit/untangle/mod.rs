@@ -363,10 +363,19 @@ fn local_passes(
     Ok(bad.len())
 }
 
-/// Flips the best non-locked edge of folded face `f` when both new faces are unfolded.
-fn try_edge_flip(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
+/// A flip of face `f`'s non-locked edge: the face across it and the two faces of the other
+/// diagonal, `[c, a, d]` and `[d, b, c]` for `f = (a, b, c)` and the neighbour's corner `d`.
+pub(super) struct FlipQuad {
+    pub g: u32,
+    pub old: [[u32; 3]; 2],
+    pub new: [[u32; 3]; 2],
+}
+
+/// The flips of face `f`'s edges that are allowed: not locked, with a neighbour, and not making
+/// an edge the mesh already has.
+pub(super) fn flip_quads(mesh: &TriMesh, ctx: &Ctx, f: u32) -> Vec<FlipQuad> {
     let t = mesh.tris[f as usize];
-    let mut best: Option<(f64, u32, [u32; 3], [u32; 3])> = None;
+    let mut out = Vec::new();
     for k in 0..3 {
         let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
         if ctx.locked(a, b) {
@@ -378,24 +387,36 @@ fn try_edge_flip(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
         if d == c || mesh.has_edge(c, d) {
             continue;
         }
-        let (n1, n2) = ([c, a, d], [d, b, c]);
-        let p = |v: u32| mesh.pos[v as usize];
-        let (s1, s2) = (ctx.score(n1, p), ctx.score(n2, p));
+        out.push(FlipQuad { g, old: [t, tg], new: [[c, a, d], [d, b, c]] });
+    }
+    out
+}
+
+/// Replaces face `f` and `q.g` by `q.new`.
+pub(super) fn apply_flip(mesh: &mut TriMesh, f: u32, q: &FlipQuad) -> bool {
+    mesh.remove_face(f);
+    mesh.remove_face(q.g);
+    let (ok1, ok2) = (mesh.add_face(q.new[0]), mesh.add_face(q.new[1]));
+    debug_assert!(ok1.is_ok() && ok2.is_ok());
+    ok1.is_ok() && ok2.is_ok()
+}
+
+/// Flips the best non-locked edge of folded face `f` when both new faces are unfolded.
+fn try_edge_flip(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
+    let p = |v: u32| mesh.pos[v as usize];
+    let mut best: Option<(f64, FlipQuad)> = None;
+    for q in flip_quads(mesh, ctx, f) {
+        let (s1, s2) = (ctx.score(q.new[0], p), ctx.score(q.new[1], p));
         if s1 <= MIN_COS || s2 <= MIN_COS {
             continue;
         }
         // Prefer the flip whose worse face is the better oriented.
-        let q = s1.min(s2);
-        if best.is_none_or(|b| q > b.0) {
-            best = Some((q, g, n1, n2));
+        let worse = s1.min(s2);
+        if best.as_ref().is_none_or(|b| worse > b.0) {
+            best = Some((worse, q));
         }
     }
-    let Some((_, g, n1, n2)) = best else { return false };
-    mesh.remove_face(f);
-    mesh.remove_face(g);
-    let (ok1, ok2) = (mesh.add_face(n1), mesh.add_face(n2));
-    debug_assert!(ok1.is_ok() && ok2.is_ok());
-    ok1.is_ok() && ok2.is_ok()
+    best.is_some_and(|(_, q)| apply_flip(mesh, f, &q))
 }
 
 /// Moves one free vertex of `f` (or of a face around `f`'s corners) to a ring mean when that

@@ -16,7 +16,7 @@ use crate::job::Progress;
 use crate::mesh::Point3;
 
 use super::super::trimesh::TriMesh;
-use super::{Ctx, FOLD_ANGLE_DEG, MIN_COS};
+use super::{apply_flip, flip_quads, Ctx, FlipQuad, FOLD_ANGLE_DEG, MIN_COS};
 
 /// A face whose normal's cosine with its reference is below this stands steeply on the surface.
 pub(crate) const STEEP_COS: f64 = 0.3;
@@ -88,37 +88,23 @@ fn folds(mesh: &TriMesh, faces: [[u32; 3]; 2]) -> usize {
 }
 
 fn flip_best(mesh: &mut TriMesh, ctx: &Ctx, f: u32) -> bool {
-    let t = mesh.tris[f as usize];
     let p = |v: u32| mesh.pos[v as usize];
-    let mut best: Option<(f64, u32, [u32; 3], [u32; 3])> = None;
-    for k in 0..3 {
-        let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
-        if ctx.locked(a, b) {
-            continue;
-        }
-        let Some(g) = mesh.face_with_edge(b, a) else { continue };
-        let tg = mesh.tris[g as usize];
-        let Some(&d) = tg.iter().find(|&&v| v != a && v != b) else { continue };
-        if d == c || mesh.has_edge(c, d) {
-            continue;
-        }
+    let mut best: Option<(f64, FlipQuad)> = None;
+    for q in flip_quads(mesh, ctx, f) {
+        let [t, tg] = q.old;
+        let [n1, n2] = q.new;
         let old = ctx.score(t, p).min(ctx.score(tg, p));
-        let (n1, n2) = ([c, a, d], [d, b, c]);
         let new = ctx.score(n1, p).min(ctx.score(n2, p));
         let floor = min_angle_deg(mesh, t).min(min_angle_deg(mesh, tg)).min(MIN_FLIP_ANGLE_DEG);
         if new <= old || new <= MIN_COS || min_angle_deg(mesh, n1).min(min_angle_deg(mesh, n2)) < floor {
             continue;
         }
-        if folds(mesh, [n1, n2]) > folds(mesh, [t, tg]) {
+        if folds(mesh, q.new) > folds(mesh, q.old) {
             continue;
         }
-        if best.is_none_or(|b| new > b.0) {
-            best = Some((new, g, n1, n2));
+        if best.as_ref().is_none_or(|b| new > b.0) {
+            best = Some((new, q));
         }
     }
-    let Some((_, g, n1, n2)) = best else { return false };
-    mesh.remove_face(f);
-    mesh.remove_face(g);
-    let (ok1, ok2) = (mesh.add_face(n1), mesh.add_face(n2));
-    ok1.is_ok() && ok2.is_ok()
+    best.is_some_and(|(_, q)| apply_flip(mesh, f, &q))
 }
