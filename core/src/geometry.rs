@@ -83,6 +83,11 @@ pub fn corner_angle(a: Point3, b: Point3, c: Point3) -> f64 {
     norm(cross(u, v)).atan2(dot(u, v))
 }
 
+/// The smallest corner angle of triangle (a, b, c), in degrees.
+pub fn min_angle_deg(a: Point3, b: Point3, c: Point3) -> f64 {
+    corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b)).to_degrees()
+}
+
 /// Axis-aligned bounding box; `None` for an empty point set.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize, utoipa::ToSchema)]
 pub struct Aabb {

@@ -31,7 +31,7 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::geometry::{add, corner_angle, dot, normalize, scale, sub, triangle_cross};
+use crate::geometry::{add, dot, min_angle_deg, normalize, scale, sub, triangle_cross};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -39,7 +39,7 @@ use super::degenerate::is_zero_area;
 use super::orientation::Orientation;
 use super::reference::SplitReference;
 use super::trimesh::{EdgeSet, TriMesh};
-use super::untangle::{self, FOLD_ANGLE_DEG};
+use super::untangle::{self, folded_pair};
 use super::uvs::{self, UvMove};
 
 mod edits;
@@ -286,12 +286,13 @@ pub fn repair_counted(
         };
         // Rounds: a sequence can turn a neighbour's neighbourhood into one another sequence
         // fixes (session 20: flips −5 % and −7 % on the deformed sets with 3 rounds).
-        for _ in 0..SEQUENCE_ROUNDS {
+        for round in 1..=SEQUENCE_ROUNDS {
             let (regions, flips) =
                 untangle::guarded_flip_sequences(mesh, &*counted, fixed, locked, &bad, &guard, progress)?;
             stats.flip_sequences += regions;
             stats.sequence_flips += flips;
-            if regions == 0 {
+            // The faces left are counted once more below; a recount here is for the next round.
+            if regions == 0 || round == SEQUENCE_ROUNDS {
                 break;
             }
             bad = counted_faces(mesh, &*counted, progress)?;
@@ -432,17 +433,6 @@ fn counted_faces(mesh: &TriMesh, counted: &impl Counted, progress: &Progress) ->
 }
 
 /// The smallest corner angle of a triangle, degrees.
-fn min_angle_deg(a: Point3, b: Point3, c: Point3) -> f64 {
-    corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b)).to_degrees()
-}
-
-/// Whether unnormalised normals `n`, `m` are folded onto each other (the fold measure's rule;
-/// a degenerate one is never folded).
-fn folded(n: Point3, m: Point3) -> bool {
-    let d = (dot(n, n) * dot(m, m)).sqrt();
-    d != 0.0 && dot(n, m) / d < FOLD_ANGLE_DEG.to_radians().cos()
-}
-
 /// The judgement of an edit from the touched faces before and after: counted faces, folded face
 /// pairs, and the smallest angle / degeneracy of the faces made or moved.
 struct Tally {
@@ -522,7 +512,7 @@ fn tally(pos: &[Point3], counted: &impl Counted, faces: &[[u32; 3]], pairs: &[(P
         t.min_angle = t.min_angle.min(min_angle_deg(a, b, c));
         t.degenerate |= is_zero_area(a, b, c);
     }
-    t.folds = pairs.iter().filter(|(n, m)| folded(*n, *m)).count();
+    t.folds = pairs.iter().filter(|(n, m)| folded_pair(*n, *m)).count();
     t
 }
 

@@ -26,6 +26,14 @@ use crate::topology::Csr;
 /// the ~180° of a face turned over.
 pub const FOLD_ANGLE_DEG: f64 = 150.0;
 
+/// Whether two adjacent faces with unnormalised normals `n`, `m` fold onto each other (normals
+/// more than [`FOLD_ANGLE_DEG`] apart; a degenerate face never folds): [`fold_stats`]'s rule for
+/// one pair, for the repairs that judge an edit by the folds it adds.
+pub fn folded_pair(n: Point3, m: Point3) -> bool {
+    let d = (dot(n, n) * dot(m, m)).sqrt();
+    d != 0.0 && dot(n, m) / d < FOLD_ANGLE_DEG.to_radians().cos()
+}
+
 #[derive(Debug, Clone, Copy, Default, Serialize, PartialEq)]
 pub struct FoldStats {
     /// Interior edges whose two faces' normals differ by more than [`FOLD_ANGLE_DEG`].

@@ -31,7 +31,7 @@ mod kernel;
 mod patch;
 mod steep;
 
-pub use folds::{fold_stats, FoldStats, FOLD_ANGLE_DEG};
+pub use folds::{fold_stats, folded_pair, FoldStats, FOLD_ANGLE_DEG};
 pub(crate) use kernel::{kernel_centre, RingFrame};
 
 /// A face counts as folded when its normal is within this cosine of perpendicular to the reference

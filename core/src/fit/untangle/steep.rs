@@ -11,12 +11,11 @@
 //! moves, so chains and curve points stay as they are.
 
 use crate::error::Result;
-use crate::geometry::{corner_angle, dot, normalize, triangle_cross};
+use crate::geometry::{self, triangle_cross};
 use crate::job::Progress;
-use crate::mesh::Point3;
 
 use super::super::trimesh::TriMesh;
-use super::{apply_flip, flip_quads, Ctx, FlipQuad, FOLD_ANGLE_DEG, MIN_COS};
+use super::{apply_flip, flip_quads, folded_pair, Ctx, FlipQuad, MIN_COS};
 
 /// A face whose normal's cosine with its reference is below this stands steeply on the surface.
 pub(crate) const STEEP_COS: f64 = 0.3;
@@ -53,21 +52,16 @@ pub(super) fn flip_steep(mesh: &mut TriMesh, ctx: &Ctx, progress: &Progress) -> 
 
 fn min_angle_deg(mesh: &TriMesh, t: [u32; 3]) -> f64 {
     let p = |v: u32| mesh.pos[v as usize];
-    (0..3)
-        .map(|k| corner_angle(p(t[k]), p(t[(k + 1) % 3]), p(t[(k + 2) % 3])))
-        .fold(f64::MAX, f64::min)
-        .to_degrees()
+    geometry::min_angle_deg(p(t[0]), p(t[1]), p(t[2]))
 }
 
-/// Folded pairs (normals more than [`FOLD_ANGLE_DEG`] apart) among the two faces of a quad and
-/// between each and its neighbour across the quad's four outer edges.
+/// Folded pairs ([`folded_pair`]) among the two faces of a quad and between each and its
+/// neighbour across the quad's four outer edges.
 fn folds(mesh: &TriMesh, faces: [[u32; 3]; 2]) -> usize {
     let p = |v: u32| mesh.pos[v as usize];
-    let normal = |t: [u32; 3]| normalize(triangle_cross(p(t[0]), p(t[1]), p(t[2])));
-    let limit = FOLD_ANGLE_DEG.to_radians().cos();
-    let folded = |n: Point3, m: Point3| n != [0.0; 3] && m != [0.0; 3] && dot(n, m) < limit;
+    let normal = |t: [u32; 3]| triangle_cross(p(t[0]), p(t[1]), p(t[2]));
     let (n0, n1) = (normal(faces[0]), normal(faces[1]));
-    let mut count = usize::from(folded(n0, n1));
+    let mut count = usize::from(folded_pair(n0, n1));
     for (t, n) in [(faces[0], n0), (faces[1], n1)] {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
@@ -80,7 +74,7 @@ fn folds(mesh: &TriMesh, faces: [[u32; 3]; 2]) -> usize {
                 continue;
             }
             if let Some(g) = mesh.face_with_edge(b, a) {
-                count += usize::from(folded(n, normal(mesh.tris[g as usize])));
+                count += usize::from(folded_pair(n, normal(mesh.tris[g as usize])));
             }
         }
     }
