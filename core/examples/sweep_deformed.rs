@@ -83,6 +83,7 @@ fn main() {
                     serde_json::json!({ "coplanar_centres": "augment", "pairs": crossing_pairs(&sections, &t, 12, d) })
                 };
                 let clock = Instant::now();
+                let curves_in = curves.clone();
                 let out = job::run(JobKind::Fit, vec![t.clone(), curves], p, &Progress::new());
                 let secs = clock.elapsed().as_secs_f64();
                 match out {
@@ -109,6 +110,9 @@ fn main() {
                                 r["fine"]["approach"]["out_of_order_before"],
                                 r["fine"]["approach"]["stretched_before"]
                             );
+                        }
+                        if let Ok(dir) = std::env::var("SWEEP_DUMP") {
+                            dump(&dir, &t, &curves_in, m, r);
                         }
                         if std::env::var("SWEEP_FOLDS").is_ok() {
                             print_folds(m);
@@ -175,4 +179,22 @@ fn print_folds(m: &meshwork_core::mesh::Mesh) {
             }
         }
     }
+}
+
+/// `SWEEP_DUMP=DIR`: the case's template, curves and output as OBJ and the report as JSON, for a
+/// look at one row by hand (name filter first).
+fn dump(
+    dir: &str,
+    template: &meshwork_core::mesh::Mesh,
+    curves: &meshwork_core::mesh::Mesh,
+    out: &meshwork_core::mesh::Mesh,
+    report: &serde_json::Value,
+) {
+    use meshwork_core::io::{write, Format};
+    std::fs::create_dir_all(dir).expect("dump dir");
+    for (name, m) in [("template", template), ("curves", curves), ("out", out)] {
+        std::fs::write(format!("{dir}/{name}.obj"), write(m, Format::Obj).expect("write")).expect("dump");
+    }
+    std::fs::write(format!("{dir}/report.json"), serde_json::to_string_pretty(report).expect("json"))
+        .expect("dump");
 }

@@ -6,7 +6,7 @@ use crate::mesh::Point3;
 
 use super::super::trimesh::IntMap;
 use super::dijkstra::{dijkstra_project, Projected};
-use super::snap::keeps_orientation;
+use super::snap::{keeps_orientation, SNAP_MAX_TURN_COS};
 use super::split::split_crossings;
 use super::stats::{detour, FailedSegment, Fallback};
 use super::{lock_chain, off_surface, route, Work};
@@ -85,17 +85,8 @@ impl Work<'_> {
             Err(_) => true,
             Ok(crossings) => {
                 let pos = &self.mesh.pos;
-                let mut at = pos[from as usize];
-                let mut len = 0.0;
-                for c in &crossings {
-                    let (pl, pr) = (pos[c.l as usize], pos[c.r as usize]);
-                    let x =
-                        crate::geometry::add(pl, crate::geometry::scale(crate::geometry::sub(pr, pl), c.lam));
-                    len += crate::geometry::dist(at, x);
-                    at = x;
-                }
-                len += crate::geometry::dist(at, pos[w as usize]);
-                len > super::LONG_DETOUR * crate::geometry::dist(pos[from as usize], pos[w as usize])
+                route_length(pos, from, w, &crossings)
+                    > super::LONG_DETOUR * crate::geometry::dist(pos[from as usize], pos[w as usize])
             }
         }
     }
@@ -145,11 +136,25 @@ impl Work<'_> {
         }
         for &m in new {
             let target = closest_on_segment(mesh.pos[m as usize], seg.0, seg.1);
-            if keeps_orientation(mesh, m, target, |f| before.get(&f).copied()) {
+            if keeps_orientation(mesh, m, target, |f| before.get(&f).copied(), SNAP_MAX_TURN_COS) {
                 self.uv_moves.extend(super::super::uvs::record(mesh, m, target));
                 mesh.pos[m as usize] = target;
                 self.stats.route_vertices_on_segment += 1;
             }
         }
     }
+}
+
+/// Length of the polyline from `from` through the route's crossing points to `to`.
+fn route_length(pos: &[Point3], from: u32, to: u32, crossings: &[route::Crossing]) -> f64 {
+    use crate::geometry::{add, dist, scale, sub};
+    let mut at = pos[from as usize];
+    let mut len = 0.0;
+    for c in crossings {
+        let (pl, pr) = (pos[c.l as usize], pos[c.r as usize]);
+        let x = add(pl, scale(sub(pr, pl), c.lam));
+        len += dist(at, x);
+        at = x;
+    }
+    len + dist(at, pos[to as usize])
 }
