@@ -42,9 +42,9 @@ mod jacobian;
 mod repair;
 mod replay;
 
-pub(super) use jacobian::det;
-use jacobian::{cofactor, field_step, frobenius, mat_vec};
+use jacobian::{cofactor, frobenius, mat_vec};
 pub use jacobian::{cofactor_times, mat_mul, push_normal};
+pub(super) use jacobian::{det, field_step};
 pub use repair::AfterLastMap;
 use replay::{Replay, Step};
 

@@ -48,6 +48,6 @@ pub(super) fn frobenius(j: &Jacobian) -> f64 {
 }
 
 /// I + step · g: the Jacobian of x ↦ x + step · s(x) from the field's gradient g.
-pub(super) fn field_step(g: &Jacobian, step: f64) -> Jacobian {
+pub(in crate::fit) fn field_step(g: &Jacobian, step: f64) -> Jacobian {
     std::array::from_fn(|r| std::array::from_fn(|c| step * g[r][c] + if r == c { 1.0 } else { 0.0 }))
 }
