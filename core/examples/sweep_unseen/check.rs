@@ -67,6 +67,15 @@ pub fn invariants(template: &Mesh, curves: &Mesh, out: &Output) -> Vec<String> {
     };
     // Points welded into another within join_tolerance moved by at most the reported distance.
     let overlap_gap = overlap_gap.max(r["network"]["welded_max_distance"].as_f64().unwrap_or(0.0));
+    // Two curves crossing near a sample of each are joined by merging the samples (or a T-junction's
+    // end put onto the other curve): a point moved by at most the reported junction gap.
+    let joined = r["network"]["crossings_at_vertices"].as_u64().unwrap_or(0)
+        + r["network"]["t_junctions"].as_u64().unwrap_or(0);
+    let overlap_gap = if joined > 0 {
+        overlap_gap.max(r["network"]["junction_max_gap"].as_f64().unwrap_or(0.0))
+    } else {
+        overlap_gap
+    };
     if worst > (1e-9 * cdiag).max(overlap_gap * (1.0 + 1e-9))
         && r["network"]["near_duplicates_merged"] == 0
         && r["network"]["ends_merged"] == 0
