@@ -469,29 +469,23 @@ fn inverted_vertices(gradients: &[Jacobian], step: f64) -> Vec<usize> {
     (0..gradients.len()).filter(|&v| !(det(&field_step(&gradients[v], step)) > 0.0)).collect()
 }
 
-/// The faces [`folds`] counts, by index.
-fn folded_faces(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> Vec<usize> {
-    (0..tris.len())
-        .filter(|&f| {
-            let t = tris[f];
-            let p = |x: &[Point3], i: usize| x[t[i] as usize];
-            let nb = triangle_cross(p(before, 0), p(before, 1), p(before, 2));
-            let na = triangle_cross(p(after, 0), p(after, 1), p(after, 2));
-            dot(nb, na) <= 0.0 && dot(nb, nb) > 0.0
-        })
-        .collect()
+/// Whether face `t` turned over from `before` to `after` (a face of zero area before never counts).
+fn turned_over(before: &[Point3], after: &[Point3], t: &[u32; 3]) -> bool {
+    let p = |x: &[Point3], i: usize| x[t[i] as usize];
+    let nb = triangle_cross(p(before, 0), p(before, 1), p(before, 2));
+    let na = triangle_cross(p(after, 0), p(after, 1), p(after, 2));
+    dot(nb, na) <= 0.0 && dot(nb, nb) > 0.0
 }
 
+/// The faces [`folds`] counts, by index.
+fn folded_faces(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> Vec<usize> {
+    (0..tris.len()).filter(|&f| turned_over(before, after, &tris[f])).collect()
+}
+
+/// How many faces turned over from `before` to `after` (the approach levels' and the warp's test).
 pub fn folds(before: &[Point3], after: &[Point3], tris: &[[u32; 3]]) -> usize {
     use rayon::prelude::*;
-    tris.par_iter()
-        .filter(|t| {
-            let p = |x: &[Point3], i: usize| x[t[i] as usize];
-            let nb = triangle_cross(p(before, 0), p(before, 1), p(before, 2));
-            let na = triangle_cross(p(after, 0), p(after, 1), p(after, 2));
-            dot(nb, na) <= 0.0 && dot(nb, nb) > 0.0
-        })
-        .count()
+    tris.par_iter().filter(|t| turned_over(before, after, t)).count()
 }
 
 /// Curve points no closer than `h` to each other (greedy, feature points first, fixed points
