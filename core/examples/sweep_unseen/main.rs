@@ -24,6 +24,7 @@
 //! into the family of what it varies (a new file for a new family, listed in `cases()`).
 
 mod check;
+mod coarse;
 mod densities;
 mod formats;
 mod layouts;
@@ -51,6 +52,7 @@ fn cases() -> Vec<Case> {
     [
         templates::templates(),
         shapes::shapes(),
+        coarse::coarse(),
         readers::readers(),
         networks::networks(),
         pairs::pairs(),
@@ -99,6 +101,16 @@ fn main() {
         let t = Instant::now();
         let result = catch_unwind(AssertUnwindSafe(|| {
             let inputs = (c.inputs)()?;
+            // SWEEP_DUMP=DIR: the row's inputs as OBJ, to run again with the CLI.
+            if let Ok(dir) = std::env::var("SWEEP_DUMP") {
+                use meshwork_core::io::{write, Format};
+                let _ = std::fs::create_dir_all(&dir);
+                for (name, m) in ["template", "curves"].iter().zip(&inputs) {
+                    if let Ok(bytes) = write(m, Format::Obj) {
+                        let _ = std::fs::write(format!("{dir}/{name}.obj"), bytes);
+                    }
+                }
+            }
             let keep = (inputs[0].clone(), inputs[1].clone());
             let mut params = c.params.clone();
             if let Ok(extra) = std::env::var("SWEEP_PARAMS") {
@@ -168,6 +180,21 @@ fn main() {
                     let radial = meshwork_core::fit::testdata::faces_against(m, |c| {
                         [c[0] - centre[0], c[1] - centre[1], c[2] - centre[2]]
                     });
+                    // Cross-template rows: the shared mesh the curves were cut from.
+                    let source = c
+                        .name
+                        .split_once("sections of ")
+                        .map(|(_, r)| r.split(' ').next().unwrap_or(""))
+                        .or_else(|| {
+                            c.name.split_once("'s sections").map(|(l, _)| l.rsplit(' ').next().unwrap_or(""))
+                        });
+                    if let Some(name) = source.filter(|n| !support::shared(n).is_empty()) {
+                        let (_, raw, _) = support::sections_of(name);
+                        eprintln!(
+                            "  faces against the source surface ({name}) {}",
+                            meshwork_core::fit::testdata::TruthSurface::new(&raw).faces_against(m)
+                        );
+                    }
                     eprintln!(
                         "  faces against the template surface {}; against the radial direction {}",
                         meshwork_core::fit::testdata::TruthSurface::new(&template).faces_against(m),

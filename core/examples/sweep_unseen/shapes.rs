@@ -84,6 +84,12 @@ pub fn shapes() -> Vec<Case> {
     for (label, s, o) in [("spot scaled 1e-4", 1e-4, 0.0), ("spot size 1 at offset 1e6", 1.0, 1e6)] {
         out.push(case(label, move || spot_and_sections_moved(s, [o, -o, o]), json!({}), Expect::Fit(None)));
     }
+    // A sphere template against the sections of every other shared mesh (scans, CAD, multi-piece,
+    // open): the cross-template fit a user of the service would try first.
+    for name in ["stanford-bunny", "cow", "rocker-arm", "alligator", "teapot", "suzanne", "beetle", "woody"] {
+        let label = format!("icosphere vs sections of {name} (auto)");
+        out.push(case(&label, move || icosphere_vs_sections_of(name), json!({}), Expect::Fit(None)));
+    }
     out.push(case(
         "icosphere vs sections of fandisk (auto)",
         || icosphere_vs_sections_of("fandisk"),

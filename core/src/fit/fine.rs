@@ -52,14 +52,46 @@ pub struct FineReport {
     pub approach_ms: f64,
 }
 
+/// The largest `max_curve_distance` used when part of the network is far from the rest (a
+/// stray curve): the automatic alignment stretches the template towards such a part, and a
+/// looser limit then lets the approach drag the template onto it instead of naming it.
+pub(super) const STRAY_MAX_CURVE_DISTANCE: f64 = 0.25;
+
+/// The lengths the fine stage measures against, fixed once the template is aligned.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Reach {
+    /// The aligned template's bounding-box diagonal (the smaller of it and the given one when the
+    /// network has a stray part).
+    pub diag: f64,
+    /// The `max_curve_distance` in force: the parameter, at most [`STRAY_MAX_CURVE_DISTANCE`]
+    /// when the network has a stray part.
+    pub factor: f64,
+    /// Whether part of the network is far from the rest ([`curves::CurveNetwork::stray_parts`]).
+    pub stray: bool,
+}
+
+impl Reach {
+    pub fn new(params: &FitParams, aligned_diag: f64, given_diag: f64, stray: bool) -> Reach {
+        if stray {
+            Reach {
+                diag: aligned_diag.min(given_diag),
+                factor: params.max_curve_distance.min(STRAY_MAX_CURVE_DISTANCE),
+                stray,
+            }
+        } else {
+            Reach { diag: aligned_diag, factor: params.max_curve_distance, stray }
+        }
+    }
+
+    /// The distance past which a curve vertex is an input error.
+    pub fn limit(&self) -> f64 {
+        self.factor * self.diag
+    }
+}
+
 /// Fails, naming the curve, when a curve vertex is farther than the limit from its template vertex.
-fn check_distances(
-    distances: &[f64],
-    net: &curves::CurveNetwork,
-    params: &FitParams,
-    template_diag: f64,
-) -> Result<()> {
-    let limit = params.max_curve_distance * template_diag;
+fn check_distances(distances: &[f64], net: &curves::CurveNetwork, reach: Reach) -> Result<()> {
+    let (limit, template_diag, factor) = (reach.limit(), reach.diag, reach.factor);
     // The farthest point names the curve: with an automatic alignment one stray curve drags the
     // template towards it, and the first point over the limit is then on a good curve.
     let far = distances.iter().enumerate().filter(|(_, &d)| d > limit).max_by(|a, b| a.1.total_cmp(b.1));
@@ -74,16 +106,16 @@ fn check_distances(
         curves.sort_unstable();
         curves.dedup();
         // A part of the network far from the rest is the likely cause: name it first.
-        let stray = net.stray_parts();
+        let stray = if reach.stray { net.stray_parts() } else { Vec::new() };
         if let Some((sc, gap, size)) = stray.first() {
             return Err(Error::params(
                 "curves",
                 format!(
                     "curve {} is {gap:.4} away from the rest of the network, farther than the rest's \
                      size ({size:.4}), and the curves do not fit the template (point {:?} of curve {c} is \
-                     {d:.4} from it after alignment, more than max_curve_distance ({}) × the template's \
+                     {d:.4} from it after alignment, more than {factor} × the template's \
                      bounding-box diagonal): a stray curve? (curves of that part: {sc:?})",
-                    sc[0], net.points[p], params.max_curve_distance
+                    sc[0], net.points[p]
                 ),
             ));
         }
@@ -96,9 +128,9 @@ fn check_distances(
             "curves",
             format!(
                 "curve {c}: its point {:?} is {d:.4} from the template, more than \
-                 max_curve_distance ({}) × the template's bounding-box diagonal ({template_diag:.4}) \
+                 max_curve_distance ({factor}) × the template's bounding-box diagonal ({template_diag:.4}) \
                  after alignment{others}; the curves do not lie on the template (check units, or give pairs)",
-                net.points[p], params.max_curve_distance
+                net.points[p]
             ),
         ));
     }
@@ -113,7 +145,7 @@ pub(super) fn fine_dispatch(
     net: &curves::CurveNetwork,
     coarse: &CoarseReport,
     params: &FitParams,
-    template_diag: f64,
+    reach: Reach,
     parents: &mut Vec<[(u32, f64); 3]>,
     search: insert::FootSearch,
     orientation: &mut Orientation,
@@ -123,7 +155,7 @@ pub(super) fn fine_dispatch(
     match params.matching {
         Matching::Insert => {
             let (fine, gradients) =
-                fine_fit_inserted(pos, tris, net, coarse, params, template_diag, parents, search, progress)?;
+                fine_fit_inserted(pos, tris, net, coarse, params, reach, parents, search, progress)?;
             orientation.sync(parents);
             if gradients.len() != pos.len() {
                 return Err(Error::Internal(format!(
@@ -136,7 +168,7 @@ pub(super) fn fine_dispatch(
             Ok(fine)
         }
         Matching::NearestVertex => {
-            let (fine, field) = fine_fit(pos, tris, net, coarse, params, template_diag, parents, progress)?;
+            let (fine, field) = fine_fit(pos, tris, net, coarse, params, reach, parents, progress)?;
             orientation.sync(parents);
             orientation.push_field(pos, std::sync::Arc::new(field), 1.0, progress)?;
             Ok(fine)
@@ -156,7 +188,7 @@ fn fine_fit_inserted(
     net: &curves::CurveNetwork,
     coarse: &CoarseReport,
     params: &FitParams,
-    template_diag: f64,
+    reach: Reach,
     parents: &mut Vec<[(u32, f64); 3]>,
     search: insert::FootSearch,
     progress: &Progress,
@@ -174,7 +206,7 @@ fn fine_fit_inserted(
         tris,
         net,
         &pair_fixed,
-        params.end_snap * template_diag,
+        params.end_snap * reach.diag,
         Some(search),
         progress,
     )?;
@@ -186,7 +218,7 @@ fn fine_fit_inserted(
     drop(before);
     let vop = ins.vertex_of_point.clone();
     let distances: Vec<f64> = (0..vop.len()).map(|p| dist(net.points[p], pos[vop[p] as usize])).collect();
-    check_distances(&distances, net, params, template_diag)?;
+    check_distances(&distances, net, reach)?;
     let all_centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
     // Template vertices the insertion made at one place (a last resort: piled feet are spread,
     // see [`insert::pileup`]) are one centre; the others still land exactly on their points below.
@@ -288,7 +320,7 @@ fn fine_fit(
     net: &curves::CurveNetwork,
     coarse: &CoarseReport,
     params: &FitParams,
-    template_diag: f64,
+    reach: Reach,
     parents: &mut Vec<[(u32, f64); 3]>,
     progress: &Progress,
 ) -> Result<(Fine, Rbf)> {
@@ -301,7 +333,7 @@ fn fine_fit(
     for round in 0..=params.max_flip_iterations {
         progress.check()?;
         let corr = correspond::closest(pos, net, &pair_fixed, progress)?;
-        check_distances(&corr.distances, net, params, template_diag)?;
+        check_distances(&corr.distances, net, reach)?;
         let vop = corr.vertex_of_point.clone();
         let centres: Vec<Point3> = vop.iter().map(|&v| pos[v as usize]).collect();
         let values: Vec<Point3> = (0..vop.len()).map(|p| sub(net.points[p], centres[p])).collect();

@@ -155,9 +155,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // against the template's size before alignment. Except when part of the network is far from
     // the rest (a stray curve): the alignment then stretches the template towards it, and the
     // smaller size keeps the stray curve an error that names it.
+    // The limit itself is loose (a sphere fitted to a bunny's sections has ears 0.26 of its
+    // diagonal out after alignment), except towards a stray part: there it stays tight, or the
+    // approach drags the template onto the stray curve.
     let aligned_diag = Aabb::of(&pos).map(|b| b.diagonal()).unwrap_or(0.0);
-    let template_diag =
-        if net.stray_parts().is_empty() { aligned_diag } else { aligned_diag.min(given_diag) };
+    let reach = fine::Reach::new(params, aligned_diag, given_diag, !net.stray_parts().is_empty());
+    let template_diag = reach.diag;
 
     // Vertices added by the fine stage, as weighted combinations of older ones (vertex
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
@@ -166,7 +169,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         let clock = std::time::Instant::now();
         let pair_fixed = coarse.pair_fixed(&params.pairs);
         let levels = params.approach_levels as usize;
-        let limit = params.max_curve_distance * template_diag;
+        let limit = reach.limit();
         let approach = approach::approach(
             &mut pos,
             &mut tris,
@@ -207,7 +210,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             &net,
             &coarse,
             params,
-            template_diag,
+            reach,
             &mut parents,
             search,
             &mut orientation,

@@ -80,7 +80,10 @@ pub struct FitParams {
     /// get a shared vertex (0 disables); counted in the report's `network`.
     pub junction_tolerance: f64,
     /// A curve vertex farther than this × the template's bounding-box diagonal from every template
-    /// vertex (after alignment) is an error.
+    /// vertex (after alignment) is an error. At most 0.25 when part of the network is farther from
+    /// the rest than the rest's size (a stray curve, named in the error). The default leaves room
+    /// for templates of another shape: an icosphere against a bunny's sections has curve points
+    /// 0.26 of its diagonal out after alignment, which the approach then reaches.
     pub max_curve_distance: f64,
     /// A curve end (a curve vertex joined to one other) within this × the template's bounding-box
     /// diagonal of an open template's boundary is matched on the boundary, so the curve cuts
@@ -136,7 +139,7 @@ impl Default for FitParams {
             join_tolerance: 1e-6,
             merge_tolerance: 1e-3,
             junction_tolerance: 0.25,
-            max_curve_distance: 0.25,
+            max_curve_distance: 0.5,
             end_snap: 0.05,
             max_flip_iterations: 4,
             approach_levels: 3,
