@@ -23,6 +23,8 @@ struct Fitted {
     dev: f64,
     /// Regions the planes cut the unmapped surface into.
     regions: usize,
+    /// Centroids of the output's faces.
+    centroids: Vec<Point3>,
 }
 
 /// Fits `name` to its own sweep sections carried by `map`, with 12 pairs at section crossings or
@@ -48,6 +50,12 @@ fn fit_own_sections(name: &str, map: fn(Point3) -> Point3, with_pairs: bool) -> 
         against: surface.faces_against(m),
         dev: surface.max_distance(m),
         faces: m.face_count(),
+        centroids: m
+            .faces
+            .triangles()
+            .iter()
+            .map(|t| [0, 1, 2].map(|k| t.iter().map(|&v| m.positions[v as usize][k]).sum::<f64>() / 3.0))
+            .collect(),
         report: out.report,
         regions,
     };
@@ -136,4 +144,17 @@ fn the_output_holds_the_last_repairs_flip_sequences() {
         "the case makes flip sequences: {turned}"
     );
     assert_eq!(f.report["flipped_faces"], turned["left"], "{turned}");
+    // The report says where they are: one centroid per counted face (up to 20), each an output
+    // face's centroid.
+    let at = f.report["flipped_faces_at"].as_array().expect("flipped_faces_at");
+    let n = f.report["flipped_faces"].as_u64().expect("count") as usize;
+    assert!(n > 0, "the case leaves turned faces: {turned}");
+    assert_eq!(at.len(), n.min(20));
+    for c in at {
+        let c: Vec<f64> = c.as_array().expect("point").iter().filter_map(|x| x.as_f64()).collect();
+        assert!(
+            f.centroids.iter().any(|o| (0..3).all(|k| (o[k] - c[k]).abs() < 1e-12)),
+            "{c:?} is no output face's centroid"
+        );
+    }
 }

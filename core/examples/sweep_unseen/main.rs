@@ -187,7 +187,8 @@ fn main() {
                         .map(|(_, r)| r.split(' ').next().unwrap_or(""))
                         .or_else(|| {
                             c.name.split_once("'s sections").map(|(l, _)| l.rsplit(' ').next().unwrap_or(""))
-                        });
+                        })
+                        .or_else(|| c.name.strip_prefix("coarse ").and_then(|r| r.split(' ').next()));
                     if let Some(name) = source.filter(|n| !support::shared(n).is_empty()) {
                         let (_, raw, _) = support::sections_of(name);
                         eprintln!(

@@ -666,6 +666,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // after the literal, which is at serde_json's macro recursion limit.
     report["folded_edges"] = folds.folded_edges.into();
     report["flipped_faces_against_fine_surface"] = quality.flipped_faces_against_fine_surface.into();
+    // Where the counted faces are (the first few, by centroid): a count alone does not say where to look.
+    report["flipped_faces_at"] = serde_json::to_value(&quality.flipped_faces_at).unwrap_or_default();
     report["faces_inverted_by_maps"] = quality.faces_inverted_by_maps.into();
     report["template_vertices_welded"] = welded.into();
     report["template_repeated_corners"] = serde_json::to_value(&repeated_corners).unwrap_or_default();

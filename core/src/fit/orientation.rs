@@ -481,18 +481,23 @@ impl Orientation {
     /// Faces whose normal opposes their reference ([`Orientation::decide`]); those the error
     /// bounds leave open are decided again with exact Jacobians ([`Orientation::exact`]).
     pub fn faces_against(&self, pos: &[Point3], tris: &[[u32; 3]]) -> usize {
+        self.faces_against_list(pos, tris).len()
+    }
+
+    /// The faces [`Orientation::faces_against`] counts, by index into `tris`, ascending.
+    pub fn faces_against_list(&self, pos: &[Point3], tris: &[[u32; 3]]) -> Vec<u32> {
         let stored = |v: u32| (self.jacobians[v as usize], self.errors[v as usize]);
         let decided: Vec<Decision> = tris.par_iter().map(|t| self.decide(pos, t, stored)).collect();
-        let mut against = decided.iter().filter(|&&d| d == Decision::Against).count();
-        let open: Vec<&[u32; 3]> =
-            tris.iter().zip(&decided).filter(|x| *x.1 == Decision::Open).map(|x| x.0).collect();
-        if !open.is_empty() {
-            let exact = self.exact_at(open.iter().flat_map(|t| t.iter().copied()));
-            for t in open {
-                against += self.settle_open(pos, t, &exact) as usize;
-            }
-        }
-        against
+        let open: Vec<u32> =
+            (0..tris.len() as u32).filter(|&f| decided[f as usize] == Decision::Open).collect();
+        let exact = self.exact_at(open.iter().flat_map(|&f| tris[f as usize].iter().copied()));
+        (0..tris.len() as u32)
+            .filter(|&f| match decided[f as usize] {
+                Decision::Against => true,
+                Decision::With => false,
+                Decision::Open => self.settle_open(pos, &tris[f as usize], &exact),
+            })
+            .collect()
     }
 
     /// Whether one face is counted by [`Orientation::faces_against`]: the same decision, face by

@@ -92,6 +92,9 @@ pub struct SegmentsNotEdges {
     pub broken_after_retriangulation: usize,
 }
 
+/// How many of the turned faces the report locates (`flipped_faces_at`).
+pub const FLIPPED_AT_LISTED: usize = 20;
+
 pub struct Quality {
     pub curve_residual_max: f64,
     pub curve_residual_mean: f64,
@@ -104,6 +107,8 @@ pub struct Quality {
     /// Output faces turned against the template's normals pushed forward by the fit's maps
     /// ([`super::orientation`]).
     pub flipped_faces: usize,
+    /// Centroids of the first [`FLIPPED_AT_LISTED`] faces `flipped_faces` counts: where they are.
+    pub flipped_faces_at: Vec<Point3>,
     /// Faces the maps themselves turned inside out (det J ≤ 0 at two or more corners).
     pub faces_inverted_by_maps: usize,
     /// Output faces turned against the fine-deformed surface (the measure before session 13).
@@ -171,6 +176,7 @@ impl Quality {
                 dot(triangle_cross(a, b, c), r) < 0.0
             })
             .count();
+        let against = orientation.faces_against_list(pos, tris);
         Quality {
             curve_residual_max: res.iter().cloned().fold(0.0, f64::max),
             curve_residual_mean: res.iter().sum::<f64>() / res.len().max(1) as f64,
@@ -182,7 +188,16 @@ impl Quality {
                 ok.min(realisable) as f64 / realisable as f64
             },
             segments_not_edges: not_edges,
-            flipped_faces: orientation.faces_against(pos, tris),
+            flipped_faces: against.len(),
+            flipped_faces_at: against
+                .iter()
+                .take(FLIPPED_AT_LISTED)
+                .map(|&f| {
+                    let t = tris[f as usize];
+                    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
+                    [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+                })
+                .collect(),
             faces_inverted_by_maps: orientation.faces_inverted(tris),
             flipped_faces_against_fine_surface: flipped,
         }

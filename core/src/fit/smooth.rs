@@ -11,7 +11,8 @@
 //!    O(faces) per iteration of §4.3.4).
 //!
 //! Both flows are guarded ([`commit_safely`]): all free vertices move at once, then a vertex whose
-//! new star has a face turned over (against that face's normal before the step), or a face whose
+//! new star has a face turned over (against that face's normal before the step, or before smoothing
+//! when it was not turned then), or a face whose
 //! smallest angle got worse *and* is below the floor, has its step halved (and re-projected),
 //! and after [`MAX_HALVINGS`] halvings is left where it was (a face that fails halves the
 //! steps of all its moving corners). The floor is the larger of
@@ -122,6 +123,10 @@ pub fn smooth(
     let q_start = shape.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
     let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
+    // Each face's normal before smoothing: a face may not end turned against it (the guard's
+    // per-step test alone lets a face turn a little every step, past 90° in sum: the raw cow
+    // fitted to its own sections kept one such face, session 22).
+    let start: Vec<Point3> = tris.par_iter().map(|&t| face_normal(pos, t)).collect();
     // Stage 1: modified mean-curvature flow.
     // The positions being smoothed, replaced by each step's result (no copy per step); `pos`
     // gets them at the end.
@@ -173,11 +178,27 @@ pub fn smooth(
             })
             .collect();
         // A halved step stays on the plane it was dropped onto (old and new are both on it).
-        cur =
-            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |_, q| q).0;
+        cur = commit_safely(
+            old,
+            proposed,
+            tris,
+            &r,
+            q_floor,
+            &start,
+            &mut shape,
+            &mut scratch,
+            &mut stats,
+            |_, q| q,
+        )
+        .0;
     }
-    // Stage 2: modified Laplacian flow, back-projected onto the reference (pre-stage-2) surface.
-    let reference = cur.clone();
+    // Stage 2: modified Laplacian flow, back-projected onto the surface as it was before
+    // smoothing (the seed's p⁰, 5b: "the original surface is the reference"). Until session 22
+    // this was the surface after stage 1, whose projections onto the planes of the current faces
+    // drift off the surface at curved spots: a coarse rocker-arm fitted to the fine one's
+    // sections ended with vertices 0.013 (unit box) off the unsmoothed surface, 0.004 now
+    // (`fit_coarse_template`).
+    let reference = pos.to_vec();
     // Unit normals of the reference faces (the reference does not move in this stage).
     let ref_normals: Vec<Point3> =
         tris.par_iter().with_min_len(4096).map(|&t| normalize(face_normal(&reference, t))).collect();
@@ -208,10 +229,18 @@ pub fn smooth(
             })
             .collect();
         // A halved step is dropped back onto the reference surface like a full one.
-        let (next, kept) =
-            commit_safely(old, proposed, tris, &r, q_floor, &mut shape, &mut scratch, &mut stats, |v, q| {
-                closest_by_walk(&reference, tris, &r, ref_face[v], q).1
-            });
+        let (next, kept) = commit_safely(
+            old,
+            proposed,
+            tris,
+            &r,
+            q_floor,
+            &start,
+            &mut shape,
+            &mut scratch,
+            &mut stats,
+            |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1,
+        );
         for v in kept {
             let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], next[v as usize]);
             new_ref[v as usize] = f;
@@ -383,6 +412,7 @@ fn commit_safely(
     tris: &[[u32; 3]],
     r: &Rings,
     q_floor: f64,
+    start: &[Point3],
     shape: &mut Vec<(Point3, f64)>,
     new_shape: &mut Vec<(Point3, f64)>,
     stats: &mut SmoothStats,
@@ -397,9 +427,12 @@ fn commit_safely(
     }
     // A relative margin so that the reported angle, computed differently, cannot come out lower.
     let floor = q_floor * (1.0 + 1e-9);
-    // Turned over (or degenerate), or worse and below the floor.
-    let acceptable = |(n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
-        dot(n, n_old) > 0.0 && (q >= q_old || q >= floor)
+    // Turned over (or degenerate) against its normal before the step or before smoothing (unless
+    // it already was before the step), or worse and below the floor.
+    let acceptable = |f: usize, (n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
+        dot(n, n_old) > 0.0
+            && (q >= q_old || q >= floor)
+            && (dot(n, start[f]) > 0.0 || dot(n_old, start[f]) <= 0.0)
     };
     // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
     // of which moved comes out the same), listing the failing ones in face order (rayon's collect
@@ -411,7 +444,7 @@ fn commit_safely(
         .with_min_len(4096)
         .filter_map(|(f, (ns, (&t, &before)))| {
             *ns = face_shape(&cand, t);
-            (!acceptable(*ns, before)).then_some(f as u32)
+            (!acceptable(f, *ns, before)).then_some(f as u32)
         })
         .collect();
     let mut halvings = vec![0u8; nv];
@@ -454,7 +487,7 @@ fn commit_safely(
             .filter(|&f| {
                 let now = face_shape(&cand, tris[f as usize]);
                 new_shape[f as usize] = now;
-                !acceptable(now, shape[f as usize])
+                !acceptable(f as usize, now, shape[f as usize])
             })
             .collect();
     }
