@@ -10,7 +10,7 @@
 //!    smoothing* (closest point, found by a local walk over the reference faces, which keeps the
 //!    O(faces) per iteration of §4.3.4).
 //!
-//! Both flows are guarded ([`commit_safely`]): all free vertices move at once, then a vertex whose
+//! Both flows are guarded ([`Guard::commit`]): all free vertices move at once, then a vertex whose
 //! new star has a face turned over (against that face's normal before the step, or before smoothing
 //! when it was not turned then), or a face whose
 //! smallest angle got worse *and* is below the floor, has its step halved (and re-projected),
@@ -116,17 +116,22 @@ pub fn smooth(
 ) -> Result<SmoothStats> {
     let nv = pos.len();
     let r = rings(nv, tris);
-    let mut stats = SmoothStats::default();
     // Normal and quality of every face at the current positions, kept up to date by the guard.
-    let mut shape: Vec<(Point3, f64)> = tris.par_iter().map(|&t| face_shape(pos, t)).collect();
-    let mut scratch = shape.clone();
+    let shape: Vec<(Point3, f64)> = tris.par_iter().map(|&t| face_shape(pos, t)).collect();
     let q_start = shape.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
-    let q_floor = s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start);
+    let mut guard = Guard {
+        tris,
+        r: &r,
+        q_floor: s.min_angle_floor_deg.to_radians().sin().powi(2).max(q_start),
+        // Each face's normal before smoothing: a face may not end turned against it (the per-step
+        // test alone lets a face turn a little every step, past 90° in sum: the raw cow fitted to
+        // its own sections kept one such face, session 22).
+        start: tris.par_iter().map(|&t| face_normal(pos, t)).collect(),
+        scratch: shape.clone(),
+        shape,
+        stats: SmoothStats::default(),
+    };
     let total = (s.mcf_iterations + s.laplacian_iterations).max(1) as f64;
-    // Each face's normal before smoothing: a face may not end turned against it (the guard's
-    // per-step test alone lets a face turn a little every step, past 90° in sum: the raw cow
-    // fitted to its own sections kept one such face, session 22).
-    let start: Vec<Point3> = tris.par_iter().map(|&t| face_normal(pos, t)).collect();
     // Stage 1: modified mean-curvature flow.
     // The positions being smoothed, replaced by each step's result (no copy per step); `pos`
     // gets them at the end.
@@ -134,6 +139,7 @@ pub fn smooth(
     for it in 0..s.mcf_iterations {
         progress.fraction(it as f64 / total)?;
         let old = &cur;
+        let shape = &guard.shape;
         // One pass over the faces at the old positions: cotangent weights and centroids (the
         // normals are in `shape`, kept up to date by the guard), computed once per face instead
         // of at each corner; then one pass over the vertices.
@@ -178,19 +184,7 @@ pub fn smooth(
             })
             .collect();
         // A halved step stays on the plane it was dropped onto (old and new are both on it).
-        cur = commit_safely(
-            old,
-            proposed,
-            tris,
-            &r,
-            q_floor,
-            &start,
-            &mut shape,
-            &mut scratch,
-            &mut stats,
-            |_, q| q,
-        )
-        .0;
+        cur = guard.commit(old, proposed, |_, q| q).0;
     }
     // Stage 2: modified Laplacian flow, back-projected onto the surface as it was before
     // smoothing (the seed's p⁰, 5b: "the original surface is the reference"). Until session 22
@@ -229,18 +223,8 @@ pub fn smooth(
             })
             .collect();
         // A halved step is dropped back onto the reference surface like a full one.
-        let (next, kept) = commit_safely(
-            old,
-            proposed,
-            tris,
-            &r,
-            q_floor,
-            &start,
-            &mut shape,
-            &mut scratch,
-            &mut stats,
-            |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1,
-        );
+        let (next, kept) =
+            guard.commit(old, proposed, |v, q| closest_by_walk(&reference, tris, &r, ref_face[v], q).1);
         for v in kept {
             let (f, _) = closest_by_walk(&reference, tris, &r, ref_face[v as usize], next[v as usize]);
             new_ref[v as usize] = f;
@@ -254,7 +238,7 @@ pub fn smooth(
         cur = next;
     }
     pos.copy_from_slice(&cur);
-    Ok(stats)
+    Ok(guard.stats)
 }
 
 /// The mean-curvature flow's weight of each edge k = (t[k], t[k+1]) of a face: half the cotangent
@@ -318,7 +302,7 @@ fn orientation(pos: &[Point3], t: [u32; 3], r: Point3) -> f64 {
 /// thinner than the thinnest before smoothing counts as worse: a corner put back next to
 /// neighbours that stay smoothed must not make one). Returns how many vertices were put back.
 ///
-/// Why: the flows' guard ([`commit_safely`]) compares each step with the face's normal before
+/// Why: the flows' guard ([`Guard::commit`]) compares each step with the face's normal before
 /// that step, so a face can turn by small steps over many iterations until it faces away from
 /// the surface (a 20k-face icosphere fitted through 90° arcs: 0 flipped faces before smoothing,
 /// 1 after, and the untangling after smoothing did not unfold it). Terminates: every round puts
@@ -402,108 +386,120 @@ fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
     (n, if prod > 0.0 { norm2(n) / prod } else { 0.0 })
 }
 
-#[allow(clippy::too_many_arguments)]
-/// The positions reached from `old` towards `proposed` where that is safe (see the module doc);
-/// `reproject` puts a halved step back on the surface. Also returns the vertices whose step was
-/// halved and kept (their reference face may need updating).
-fn commit_safely(
-    old: &[Point3],
-    proposed: Vec<Point3>,
-    tris: &[[u32; 3]],
-    r: &Rings,
+/// The flows' guard: what it tests a step against, and what it did.
+struct Guard<'a> {
+    tris: &'a [[u32; 3]],
+    r: &'a Rings,
+    /// The smallest-angle quality a worsening face may reach (module doc).
     q_floor: f64,
-    start: &[Point3],
-    shape: &mut Vec<(Point3, f64)>,
-    new_shape: &mut Vec<(Point3, f64)>,
-    stats: &mut SmoothStats,
-    reproject: impl Fn(usize, Point3) -> Point3 + Sync,
-) -> (Vec<Point3>, Vec<u32>) {
-    let nv = old.len();
-    let mut cand = proposed;
-    let moves = cand.par_iter().zip(old).with_min_len(4096).filter(|(a, b)| a != b).count();
-    stats.moves += moves;
-    if moves == 0 {
-        return (cand, Vec::new());
-    }
-    // A relative margin so that the reported angle, computed differently, cannot come out lower.
-    let floor = q_floor * (1.0 + 1e-9);
-    // Turned over (or degenerate) against its normal before the step or before smoothing (unless
-    // it already was before the step), or worse and below the floor.
-    let acceptable = |f: usize, (n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
-        dot(n, n_old) > 0.0
-            && (q >= q_old || q >= floor)
-            && (dot(n, start[f]) > 0.0 || dot(n_old, start[f]) <= 0.0)
-    };
-    // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
-    // of which moved comes out the same), listing the failing ones in face order (rayon's collect
-    // keeps it, so the halvings below run as after a serial scan).
-    let mut bad: Vec<u32> = new_shape
-        .par_iter_mut()
-        .zip(tris.par_iter().zip(shape.par_iter()))
-        .enumerate()
-        .with_min_len(4096)
-        .filter_map(|(f, (ns, (&t, &before)))| {
-            *ns = face_shape(&cand, t);
-            (!acceptable(f, *ns, before)).then_some(f as u32)
-        })
-        .collect();
-    let mut halvings = vec![0u8; nv];
-    let mut vmark = vec![false; nv];
-    let mut fmark = vec![false; tris.len()];
-    while !bad.is_empty() {
-        // Halve (or give up) the step of every moving corner of a failing face.
-        let mut changed: Vec<u32> = Vec::new();
-        for &f in &bad {
-            for &v in &tris[f as usize] {
-                if cand[v as usize] != old[v as usize] && !vmark[v as usize] {
-                    vmark[v as usize] = true;
-                    changed.push(v);
-                }
-            }
+    /// Each face's normal before smoothing.
+    start: Vec<Point3>,
+    /// Each face's normal and quality at the current positions.
+    shape: Vec<(Point3, f64)>,
+    /// The same at the candidate positions (swapped with `shape` after each step).
+    scratch: Vec<(Point3, f64)>,
+    stats: SmoothStats,
+}
+
+impl Guard<'_> {
+    /// The positions reached from `old` towards `proposed` where that is safe (see the module
+    /// doc); `reproject` puts a halved step back on the surface. Also returns the vertices whose
+    /// step was halved and kept (their reference face may need updating).
+    fn commit(
+        &mut self,
+        old: &[Point3],
+        proposed: Vec<Point3>,
+        reproject: impl Fn(usize, Point3) -> Point3 + Sync,
+    ) -> (Vec<Point3>, Vec<u32>) {
+        let (tris, r, q_floor, start) = (self.tris, self.r, self.q_floor, &self.start);
+        let (shape, new_shape, stats) = (&mut self.shape, &mut self.scratch, &mut self.stats);
+        let nv = old.len();
+        let mut cand = proposed;
+        let moves = cand.par_iter().zip(old).with_min_len(4096).filter(|(a, b)| a != b).count();
+        stats.moves += moves;
+        if moves == 0 {
+            return (cand, Vec::new());
         }
-        let mut faces: Vec<u32> = Vec::new();
-        for &v in &changed {
-            let v = v as usize;
-            vmark[v] = false;
-            halvings[v] += 1;
-            cand[v] = if halvings[v] as u32 > MAX_HALVINGS {
-                old[v]
-            } else {
-                reproject(v, scale(add(old[v], cand[v]), 0.5))
-            };
-            for &f in r.vf.row(v) {
-                if !fmark[f as usize] {
-                    fmark[f as usize] = true;
-                    faces.push(f);
-                }
-            }
-        }
-        for &f in &faces {
-            fmark[f as usize] = false;
-        }
-        // Re-check the faces around the changed vertices.
-        bad = faces
-            .into_iter()
-            .filter(|&f| {
-                let now = face_shape(&cand, tris[f as usize]);
-                new_shape[f as usize] = now;
-                !acceptable(f as usize, now, shape[f as usize])
+        // A relative margin so that the reported angle, computed differently, cannot come out lower.
+        let floor = q_floor * (1.0 + 1e-9);
+        // Turned over (or degenerate) against its normal before the step or before smoothing (unless
+        // it already was before the step), or worse and below the floor.
+        let acceptable = |f: usize, (n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
+            dot(n, n_old) > 0.0
+                && (q >= q_old || q >= floor)
+                && (dot(n, start[f]) > 0.0 || dot(n_old, start[f]) <= 0.0)
+        };
+        // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
+        // of which moved comes out the same), listing the failing ones in face order (rayon's collect
+        // keeps it, so the halvings below run as after a serial scan).
+        let mut bad: Vec<u32> = new_shape
+            .par_iter_mut()
+            .zip(tris.par_iter().zip(shape.par_iter()))
+            .enumerate()
+            .with_min_len(4096)
+            .filter_map(|(f, (ns, (&t, &before)))| {
+                *ns = face_shape(&cand, t);
+                (!acceptable(f, *ns, before)).then_some(f as u32)
             })
             .collect();
-    }
-    // Every face's last evaluation is at the final positions (a face is re-evaluated whenever a
-    // corner changes): the next step's old shapes.
-    std::mem::swap(shape, new_shape);
-    let mut halved = Vec::new();
-    for (v, &h) in halvings.iter().enumerate() {
-        if h as u32 > MAX_HALVINGS {
-            stats.moves_rejected += 1;
-        } else if h > 0 {
-            stats.moves_halved += 1;
-            halved.push(v as u32);
+        let mut halvings = vec![0u8; nv];
+        let mut vmark = vec![false; nv];
+        let mut fmark = vec![false; tris.len()];
+        while !bad.is_empty() {
+            // Halve (or give up) the step of every moving corner of a failing face.
+            let mut changed: Vec<u32> = Vec::new();
+            for &f in &bad {
+                for &v in &tris[f as usize] {
+                    if cand[v as usize] != old[v as usize] && !vmark[v as usize] {
+                        vmark[v as usize] = true;
+                        changed.push(v);
+                    }
+                }
+            }
+            let mut faces: Vec<u32> = Vec::new();
+            for &v in &changed {
+                let v = v as usize;
+                vmark[v] = false;
+                halvings[v] += 1;
+                cand[v] = if halvings[v] as u32 > MAX_HALVINGS {
+                    old[v]
+                } else {
+                    reproject(v, scale(add(old[v], cand[v]), 0.5))
+                };
+                for &f in r.vf.row(v) {
+                    if !fmark[f as usize] {
+                        fmark[f as usize] = true;
+                        faces.push(f);
+                    }
+                }
+            }
+            for &f in &faces {
+                fmark[f as usize] = false;
+            }
+            // Re-check the faces around the changed vertices.
+            bad = faces
+                .into_iter()
+                .filter(|&f| {
+                    let now = face_shape(&cand, tris[f as usize]);
+                    new_shape[f as usize] = now;
+                    !acceptable(f as usize, now, shape[f as usize])
+                })
+                .collect();
         }
+        // Every face's last evaluation is at the final positions (a face is re-evaluated whenever a
+        // corner changes): the next step's old shapes.
+        std::mem::swap(shape, new_shape);
+        let mut halved = Vec::new();
+        for (v, &h) in halvings.iter().enumerate() {
+            if h as u32 > MAX_HALVINGS {
+                stats.moves_rejected += 1;
+            } else if h > 0 {
+                stats.moves_halved += 1;
+                halved.push(v as u32);
+            }
+        }
+        (cand, halved)
     }
-    (cand, halved)
 }
 
 fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
