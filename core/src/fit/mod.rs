@@ -386,7 +386,23 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
         smoothing = stages.run(progress, "smooth", || {
-            let mut s = smooth::smooth(&mut out_pos, &out_tris, &fixed, &settings, progress)?;
+            // The template's creases, held where the fit put them (template vertices keep their
+            // indices through the fit).
+            let mut held = fixed.clone();
+            let mut held_at_creases = 0;
+            if params.smooth_hold_creases_deg > 0.0 {
+                let crease = smooth::crease_vertices(
+                    &template.positions,
+                    &template_tris,
+                    params.smooth_hold_creases_deg,
+                );
+                for (h, &c) in held.iter_mut().zip(&crease) {
+                    held_at_creases += usize::from(c && !*h);
+                    *h |= c;
+                }
+            }
+            let mut s = smooth::smooth(&mut out_pos, &out_tris, &held, &settings, progress)?;
+            s.held_at_creases = held_at_creases;
             s.undone_for_flips =
                 smooth::undo_new_flips(&mut out_pos, &mesh.pos, &out_tris, &reference_normals);
             Ok(s)

@@ -103,6 +103,13 @@ pub struct FitParams {
     pub cleanup_min_angle_deg: f64,
     /// Run the smoothing stage.
     pub smooth: bool,
+    /// Smoothing holds every template vertex on a crease of the template (an edge whose faces'
+    /// normals differ by more than this, in degrees) where the fit put it (0 disables). Tangential
+    /// steps slide vertices off a crease or a tip and the chords then cut it: on a template simplified
+    /// from the surface the curves come from, smoothing without this left the surface 2–7× farther
+    /// from that surface than the unsmoothed fit (docs/benchmarks.md, session 22). Off by default:
+    /// at 30° it turned one more face in two truth tests (homer bent with pairs, the raw cow).
+    pub smooth_hold_creases_deg: f64,
     /// Iterations of the modified mean-curvature flow.
     pub mcf_iterations: u32,
     /// Fraction of the way to the cotangent-weighted ring mean per mean-curvature step (0..1].
@@ -149,6 +156,7 @@ impl Default for FitParams {
             smooth: true,
             mcf_iterations: 10,
             mcf_step: 0.5,
+            smooth_hold_creases_deg: 0.0,
             laplacian_iterations: 20,
             max_curve_vertices: 8000,
             refine_dense_feet: 8,
@@ -179,6 +187,11 @@ impl FitParams {
         }
         if !(self.snap_fraction.is_finite() && (0.0..=0.5).contains(&self.snap_fraction)) {
             return bad("snap_fraction", "must be in [0, 0.5]");
+        }
+        if !(self.smooth_hold_creases_deg.is_finite()
+            && (0.0..=180.0).contains(&self.smooth_hold_creases_deg))
+        {
+            return bad("smooth_hold_creases_deg", "must be in [0, 180]");
         }
         if !(self.mcf_step.is_finite() && self.mcf_step > 0.0 && self.mcf_step <= 1.0) {
             return bad("mcf_step", "must be in (0, 1]");

@@ -51,6 +51,8 @@ pub struct SmoothStats {
     /// Vertices put back where they were before smoothing because a face of theirs ended turned
     /// against the reference surface ([`undo_new_flips`]).
     pub undone_for_flips: usize,
+    /// Template vertices held on a crease of the template (`smooth_hold_creases_deg`).
+    pub held_at_creases: usize,
 }
 
 /// Halvings of a failing step before the vertex is left where it was.
@@ -192,7 +194,7 @@ pub fn smooth(
     // drift off the surface at curved spots: a coarse rocker-arm fitted to the fine one's
     // sections ended with vertices 0.013 (unit box) off the unsmoothed surface, 0.004 now
     // (`fit_coarse_template`).
-    let reference = pos.to_vec();
+    let reference = if std::env::var("MW_OLDREF").is_ok() { cur.clone() } else { pos.to_vec() };
     // Unit normals of the reference faces (the reference does not move in this stage).
     let ref_normals: Vec<Point3> =
         tris.par_iter().with_min_len(4096).map(|&t| normalize(face_normal(&reference, t))).collect();
@@ -239,6 +241,32 @@ pub fn smooth(
     }
     pos.copy_from_slice(&cur);
     Ok(guard.stats)
+}
+
+/// The vertices of a crease: an edge whose two faces' normals differ by more than `deg` degrees.
+/// Edges are paired by sorting (no hash map: a 100k-vertex template has 300k edges); an edge of
+/// one face (boundary) or of more than two (non-manifold) is no crease.
+pub fn crease_vertices(pos: &[Point3], tris: &[[u32; 3]], deg: f64) -> Vec<bool> {
+    let mut on = vec![false; pos.len()];
+    let cos = deg.to_radians().cos();
+    let normals: Vec<Point3> = tris.par_iter().map(|&t| normalize(face_normal(pos, t))).collect();
+    let mut edges: Vec<(u32, u32, u32)> = tris
+        .iter()
+        .enumerate()
+        .flat_map(|(f, t)| {
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]), f as u32))
+        })
+        .collect();
+    edges.par_sort_unstable();
+    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if let [(a, b, f), (_, _, g)] = run {
+            if dot(normals[*f as usize], normals[*g as usize]) < cos {
+                on[*a as usize] = true;
+                on[*b as usize] = true;
+            }
+        }
+    }
+    on
 }
 
 /// The mean-curvature flow's weight of each edge k = (t[k], t[k+1]) of a face: half the cotangent
@@ -553,6 +581,48 @@ mod tests {
     use super::*;
     use crate::geometry::norm;
     use crate::shapes::icosphere;
+
+    /// A strip of 4 × 2 squares in the plane z = 0, its right half turned up about x = 2 by
+    /// `fold` degrees: the crease is the 3 vertices on x = 2 (hand-placed, 2 triangles a square).
+    fn folded_strip(fold: f64) -> (Vec<Point3>, Vec<[u32; 3]>) {
+        let (c, s) = (fold.to_radians().cos(), fold.to_radians().sin());
+        let mut pos = Vec::new();
+        for j in 0..3 {
+            for i in 0..5 {
+                let x = i as f64;
+                let p = if x <= 2.0 {
+                    [x, j as f64, 0.0]
+                } else {
+                    [2.0 + (x - 2.0) * c, j as f64, (x - 2.0) * s]
+                };
+                pos.push(p);
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..2u32 {
+            for i in 0..4u32 {
+                let (a, b, d, e) = (j * 5 + i, j * 5 + i + 1, (j + 1) * 5 + i, (j + 1) * 5 + i + 1);
+                tris.push([a, b, e]);
+                tris.push([a, e, d]);
+            }
+        }
+        (pos, tris)
+    }
+
+    #[test]
+    fn crease_vertices_are_those_of_edges_folded_past_the_angle() {
+        let on_crease = |on: Vec<bool>| (0..on.len()).filter(|&v| on[v]).collect::<Vec<_>>();
+        // Folded by 40°: the edges on x = 2 (vertices 2, 7, 12) are past 30°, the others flat.
+        let (pos, tris) = folded_strip(40.0);
+        assert_eq!(on_crease(crease_vertices(&pos, &tris, 30.0)), vec![2, 7, 12]);
+        // Folded by 20°: no crease at 30°, the same one at 10°.
+        let (pos, tris) = folded_strip(20.0);
+        assert!(on_crease(crease_vertices(&pos, &tris, 30.0)).is_empty());
+        assert_eq!(on_crease(crease_vertices(&pos, &tris, 10.0)), vec![2, 7, 12]);
+        // A level-3 icosphere's neighbouring faces differ by less than 30°: no crease.
+        let ico = icosphere(3, 1.0);
+        assert!(!crease_vertices(&ico.positions, &ico.faces.triangles(), 30.0).contains(&true));
+    }
 
     #[test]
     fn a_face_the_smoothing_turned_over_gets_its_moved_corners_back() {
