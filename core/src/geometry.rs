@@ -69,6 +69,12 @@ pub fn triangle_cross(a: Point3, b: Point3, c: Point3) -> Point3 {
     cross(sub(b, a), sub(c, a))
 }
 
+/// The centroid of triangle (a, b, c).
+#[inline]
+pub fn triangle_centroid(a: Point3, b: Point3, c: Point3) -> Point3 {
+    scale(add(add(a, b), c), 1.0 / 3.0)
+}
+
 #[inline]
 pub fn triangle_area(a: Point3, b: Point3, c: Point3) -> f64 {
     0.5 * norm(triangle_cross(a, b, c))

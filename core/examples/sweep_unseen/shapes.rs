@@ -8,8 +8,8 @@ use meshwork_core::shapes::icosphere;
 use meshwork_core::Error;
 
 use crate::support::{
-    case, fit_inputs, flat_ellipsoid, flatten, icosphere_vs_sections_of, sections_of, sphere_sections,
-    unit_repaired, Case, Expect, AXES,
+    case, fit_inputs, flat_ellipsoid, flatten, icosphere_level_vs_sections_of, icosphere_vs_sections_of,
+    sections_of, sphere_sections, unit_repaired, Case, Expect, AXES,
 };
 
 pub fn shapes() -> Vec<Case> {
@@ -89,6 +89,18 @@ pub fn shapes() -> Vec<Case> {
     for name in ["stanford-bunny", "cow", "rocker-arm", "teapot", "suzanne", "beetle"] {
         let label = format!("icosphere vs sections of {name} (auto)");
         out.push(case(&label, move || icosphere_vs_sections_of(name), json!({}), Expect::Fit(None)));
+    }
+    // How the time grows with the sphere's density (642 to 40,962 vertices) against the same curves.
+    for name in ["spot", "cow"] {
+        for level in [4, 5, 6] {
+            let label = format!("icosphere level {level} vs sections of {name} (auto)");
+            out.push(case(
+                &label,
+                move || icosphere_level_vs_sections_of(level, name),
+                json!({}),
+                Expect::Fit(None),
+            ));
+        }
     }
     // Alligator and woody are flat (z = 0): all their sections lie in one plane, which the fine
     // RBF cannot solve without augmenting (named in the error), and can with it.

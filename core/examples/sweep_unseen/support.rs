@@ -110,8 +110,13 @@ pub fn repaired_vs_own_sections(name: &str) -> Result<Vec<Mesh>, Error> {
 /// An icosphere of radius 0.5 in the unit box (the sweep's frame) and the sections of shared
 /// mesh `name`: a template of another shape, aligned automatically.
 pub fn icosphere_vs_sections_of(name: &str) -> Result<Vec<Mesh>, Error> {
+    icosphere_level_vs_sections_of(3, name)
+}
+
+/// An icosphere of `level` (radius 0.5 in the unit box) and the sections of shared mesh `name`.
+pub fn icosphere_level_vs_sections_of(level: u32, name: &str) -> Result<Vec<Mesh>, Error> {
     let (c, _, _) = sections_of(name);
-    fit_inputs(shifted(&icosphere(3, 0.5), [0.5, 0.5, 0.5]), c)
+    fit_inputs(shifted(&icosphere(level, 0.5), [0.5, 0.5, 0.5]), c)
 }
 
 /// Plane sections of the repaired, unit-box copy of shared mesh `name`, and the unit-box raw mesh.

@@ -55,7 +55,7 @@ pub struct FineReport {
 /// The largest `max_curve_distance` used when part of the network is far from the rest (a
 /// stray curve): the automatic alignment stretches the template towards such a part, and a
 /// looser limit then lets the approach drag the template onto it instead of naming it.
-pub(super) const STRAY_MAX_CURVE_DISTANCE: f64 = 0.25;
+const STRAY_MAX_CURVE_DISTANCE: f64 = 0.25;
 
 /// The lengths the fine stage measures against, fixed once the template is aligned.
 #[derive(Clone, Copy, Debug)]

@@ -386,21 +386,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             min_angle_floor_deg: params.cleanup_min_angle_deg,
         };
         smoothing = stages.run(progress, "smooth", || {
-            // The template's creases, held where the fit put them (template vertices keep their
-            // indices through the fit).
             let mut held = fixed.clone();
-            let mut held_at_creases = 0;
-            if params.smooth_hold_creases_deg > 0.0 {
-                let crease = smooth::crease_vertices(
-                    &template.positions,
-                    &template_tris,
-                    params.smooth_hold_creases_deg,
-                );
-                for (h, &c) in held.iter_mut().zip(&crease) {
-                    held_at_creases += usize::from(c && !*h);
-                    *h |= c;
-                }
-            }
+            let held_at_creases = if params.smooth_hold_creases_deg > 0.0 {
+                let deg = params.smooth_hold_creases_deg;
+                smooth::hold_template_creases(&mut held, &template.positions, &template_tris, deg)
+            } else {
+                0
+            };
             let mut s = smooth::smooth(&mut out_pos, &out_tris, &held, &settings, progress)?;
             s.held_at_creases = held_at_creases;
             s.undone_for_flips =

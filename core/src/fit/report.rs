@@ -2,7 +2,9 @@
 
 use serde::Serialize;
 
-use crate::geometry::{add, corner_angle, dist, dot, norm2, normalize, sub, triangle_cross};
+use crate::geometry::{
+    add, corner_angle, dist, dot, norm2, normalize, sub, triangle_centroid, triangle_cross,
+};
 use crate::mesh::{Mesh, Point3};
 
 use super::curves::CurveNetwork;
@@ -194,8 +196,7 @@ impl Quality {
                 .take(FLIPPED_AT_LISTED)
                 .map(|&f| {
                     let t = tris[f as usize];
-                    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-                    [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+                    triangle_centroid(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
                 })
                 .collect(),
             faces_inverted_by_maps: orientation.faces_inverted(tris),

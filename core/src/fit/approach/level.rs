@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::geometry::{add, dot, scale, triangle_cross};
+use crate::geometry::{add, dot, scale, triangle_centroid, triangle_cross};
 use crate::job::Progress;
 use crate::mesh::Point3;
 
@@ -154,7 +154,7 @@ pub(super) fn drop_folding_centres(
 fn folding_spots(pos: &[Point3], disp: &[Point3], gradients: &[Jacobian], tris: &[[u32; 3]]) -> Vec<Point3> {
     let moved = moved_by(pos, disp, 1.0);
     let centroid =
-        |t: [u32; 3]| scale(add(add(pos[t[0] as usize], pos[t[1] as usize]), pos[t[2] as usize]), 1.0 / 3.0);
+        |t: [u32; 3]| triangle_centroid(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
     let faces = folded_faces(pos, &moved, tris).into_iter().map(|f| centroid(tris[f]));
     let vertices = (0..gradients.len()).filter(|&v| inverts(&gradients[v], 1.0)).map(|v| pos[v]);
     faces.chain(vertices).collect()

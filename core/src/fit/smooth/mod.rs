@@ -24,12 +24,18 @@
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub};
+use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub, triangle_centroid};
 use crate::job::Progress;
 use crate::mesh::Point3;
 use crate::topology::Csr;
 
 use super::reference::Reference;
+
+mod creases;
+mod guard;
+
+pub use creases::{crease_vertices, hold_template_creases};
+use guard::{face_shape, Guard};
 
 pub struct SmoothSettings {
     pub mcf_iterations: u32,
@@ -243,32 +249,6 @@ pub fn smooth(
     Ok(guard.stats)
 }
 
-/// The vertices of a crease: an edge whose two faces' normals differ by more than `deg` degrees.
-/// Edges are paired by sorting (no hash map: a 100k-vertex template has 300k edges); an edge of
-/// one face (boundary) or of more than two (non-manifold) is no crease.
-pub fn crease_vertices(pos: &[Point3], tris: &[[u32; 3]], deg: f64) -> Vec<bool> {
-    let mut on = vec![false; pos.len()];
-    let cos = deg.to_radians().cos();
-    let normals: Vec<Point3> = tris.par_iter().map(|&t| normalize(face_normal(pos, t))).collect();
-    let mut edges: Vec<(u32, u32, u32)> = tris
-        .iter()
-        .enumerate()
-        .flat_map(|(f, t)| {
-            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]), f as u32))
-        })
-        .collect();
-    edges.par_sort_unstable();
-    for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-        if let [(a, b, f), (_, _, g)] = run {
-            if dot(normals[*f as usize], normals[*g as usize]) < cos {
-                on[*a as usize] = true;
-                on[*b as usize] = true;
-            }
-        }
-    }
-    on
-}
-
 /// The mean-curvature flow's weight of each edge k = (t[k], t[k+1]) of a face: half the cotangent
 /// of the corner opposite it, negative ones clamped to 0 (they make the step leave the ring); NaN
 /// for a degenerate corner, which adds nothing (a computed weight is never NaN: `max` drops a NaN
@@ -398,140 +378,8 @@ pub fn min_angle_quality(a: Point3, b: Point3, c: Point3) -> f64 {
     }
 }
 
-/// Normal (unnormalised) and [`min_angle_quality`] of a face, sharing the edge vectors.
-fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
-    let (a, b, c) = (pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]);
-    let (ab, ac) = (sub(b, a), sub(c, a));
-    let n = cross(ab, ac);
-    let (la, lb, lc) = (norm2(sub(c, b)), norm2(ac), norm2(ab));
-    let prod = if la <= lb && la <= lc {
-        lb * lc
-    } else if lb <= lc {
-        la * lc
-    } else {
-        la * lb
-    };
-    (n, if prod > 0.0 { norm2(n) / prod } else { 0.0 })
-}
-
-/// The flows' guard: what it tests a step against, and what it did.
-struct Guard<'a> {
-    tris: &'a [[u32; 3]],
-    r: &'a Rings,
-    /// The smallest-angle quality a worsening face may reach (module doc).
-    q_floor: f64,
-    /// Each face's normal before smoothing.
-    start: Vec<Point3>,
-    /// Each face's normal and quality at the current positions.
-    shape: Vec<(Point3, f64)>,
-    /// The same at the candidate positions (swapped with `shape` after each step).
-    scratch: Vec<(Point3, f64)>,
-    stats: SmoothStats,
-}
-
-impl Guard<'_> {
-    /// The positions reached from `old` towards `proposed` where that is safe (see the module
-    /// doc); `reproject` puts a halved step back on the surface. Also returns the vertices whose
-    /// step was halved and kept (their reference face may need updating).
-    fn commit(
-        &mut self,
-        old: &[Point3],
-        proposed: Vec<Point3>,
-        reproject: impl Fn(usize, Point3) -> Point3 + Sync,
-    ) -> (Vec<Point3>, Vec<u32>) {
-        let (tris, r, q_floor, start) = (self.tris, self.r, self.q_floor, &self.start);
-        let (shape, new_shape, stats) = (&mut self.shape, &mut self.scratch, &mut self.stats);
-        let nv = old.len();
-        let mut cand = proposed;
-        let moves = cand.par_iter().zip(old).with_min_len(4096).filter(|(a, b)| a != b).count();
-        stats.moves += moves;
-        if moves == 0 {
-            return (cand, Vec::new());
-        }
-        // A relative margin so that the reported angle, computed differently, cannot come out lower.
-        let floor = q_floor * (1.0 + 1e-9);
-        // Turned over (or degenerate) against its normal before the step or before smoothing (unless
-        // it already was before the step), or worse and below the floor.
-        let acceptable = |f: usize, (n, q): (Point3, f64), (n_old, q_old): (Point3, f64)| {
-            dot(n, n_old) > 0.0
-                && (q >= q_old || q >= floor)
-                && (dot(n, start[f]) > 0.0 || dot(n_old, start[f]) <= 0.0)
-        };
-        // One pass over the faces (`shape` holds the old normal and quality of each; a face no corner
-        // of which moved comes out the same), listing the failing ones in face order (rayon's collect
-        // keeps it, so the halvings below run as after a serial scan).
-        let mut bad: Vec<u32> = new_shape
-            .par_iter_mut()
-            .zip(tris.par_iter().zip(shape.par_iter()))
-            .enumerate()
-            .with_min_len(4096)
-            .filter_map(|(f, (ns, (&t, &before)))| {
-                *ns = face_shape(&cand, t);
-                (!acceptable(f, *ns, before)).then_some(f as u32)
-            })
-            .collect();
-        let mut halvings = vec![0u8; nv];
-        let mut vmark = vec![false; nv];
-        let mut fmark = vec![false; tris.len()];
-        while !bad.is_empty() {
-            // Halve (or give up) the step of every moving corner of a failing face.
-            let mut changed: Vec<u32> = Vec::new();
-            for &f in &bad {
-                for &v in &tris[f as usize] {
-                    if cand[v as usize] != old[v as usize] && !vmark[v as usize] {
-                        vmark[v as usize] = true;
-                        changed.push(v);
-                    }
-                }
-            }
-            let mut faces: Vec<u32> = Vec::new();
-            for &v in &changed {
-                let v = v as usize;
-                vmark[v] = false;
-                halvings[v] += 1;
-                cand[v] = if halvings[v] as u32 > MAX_HALVINGS {
-                    old[v]
-                } else {
-                    reproject(v, scale(add(old[v], cand[v]), 0.5))
-                };
-                for &f in r.vf.row(v) {
-                    if !fmark[f as usize] {
-                        fmark[f as usize] = true;
-                        faces.push(f);
-                    }
-                }
-            }
-            for &f in &faces {
-                fmark[f as usize] = false;
-            }
-            // Re-check the faces around the changed vertices.
-            bad = faces
-                .into_iter()
-                .filter(|&f| {
-                    let now = face_shape(&cand, tris[f as usize]);
-                    new_shape[f as usize] = now;
-                    !acceptable(f as usize, now, shape[f as usize])
-                })
-                .collect();
-        }
-        // Every face's last evaluation is at the final positions (a face is re-evaluated whenever a
-        // corner changes): the next step's old shapes.
-        std::mem::swap(shape, new_shape);
-        let mut halved = Vec::new();
-        for (v, &h) in halvings.iter().enumerate() {
-            if h as u32 > MAX_HALVINGS {
-                stats.moves_rejected += 1;
-            } else if h > 0 {
-                stats.moves_halved += 1;
-                halved.push(v as u32);
-            }
-        }
-        (cand, halved)
-    }
-}
-
 fn centroid(pos: &[Point3], t: [u32; 3]) -> Point3 {
-    scale(add(add(pos[t[0] as usize], pos[t[1] as usize]), pos[t[2] as usize]), 1.0 / 3.0)
+    triangle_centroid(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize])
 }
 
 /// Closest point on the reference surface near face `start`: walk across the edge opposite the
@@ -581,48 +429,6 @@ mod tests {
     use super::*;
     use crate::geometry::norm;
     use crate::shapes::icosphere;
-
-    /// A strip of 4 × 2 squares in the plane z = 0, its right half turned up about x = 2 by
-    /// `fold` degrees: the crease is the 3 vertices on x = 2 (hand-placed, 2 triangles a square).
-    fn folded_strip(fold: f64) -> (Vec<Point3>, Vec<[u32; 3]>) {
-        let (c, s) = (fold.to_radians().cos(), fold.to_radians().sin());
-        let mut pos = Vec::new();
-        for j in 0..3 {
-            for i in 0..5 {
-                let x = i as f64;
-                let p = if x <= 2.0 {
-                    [x, j as f64, 0.0]
-                } else {
-                    [2.0 + (x - 2.0) * c, j as f64, (x - 2.0) * s]
-                };
-                pos.push(p);
-            }
-        }
-        let mut tris = Vec::new();
-        for j in 0..2u32 {
-            for i in 0..4u32 {
-                let (a, b, d, e) = (j * 5 + i, j * 5 + i + 1, (j + 1) * 5 + i, (j + 1) * 5 + i + 1);
-                tris.push([a, b, e]);
-                tris.push([a, e, d]);
-            }
-        }
-        (pos, tris)
-    }
-
-    #[test]
-    fn crease_vertices_are_those_of_edges_folded_past_the_angle() {
-        let on_crease = |on: Vec<bool>| (0..on.len()).filter(|&v| on[v]).collect::<Vec<_>>();
-        // Folded by 40°: the edges on x = 2 (vertices 2, 7, 12) are past 30°, the others flat.
-        let (pos, tris) = folded_strip(40.0);
-        assert_eq!(on_crease(crease_vertices(&pos, &tris, 30.0)), vec![2, 7, 12]);
-        // Folded by 20°: no crease at 30°, the same one at 10°.
-        let (pos, tris) = folded_strip(20.0);
-        assert!(on_crease(crease_vertices(&pos, &tris, 30.0)).is_empty());
-        assert_eq!(on_crease(crease_vertices(&pos, &tris, 10.0)), vec![2, 7, 12]);
-        // A level-3 icosphere's neighbouring faces differ by less than 30°: no crease.
-        let ico = icosphere(3, 1.0);
-        assert!(!crease_vertices(&ico.positions, &ico.faces.triangles(), 30.0).contains(&true));
-    }
 
     #[test]
     fn a_face_the_smoothing_turned_over_gets_its_moved_corners_back() {
