@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::geometry::{add, cross, dot, norm2, scale, sub};
 use crate::mesh::Point3;
 
-use super::{Rings, SmoothStats, MAX_HALVINGS};
+use super::{longer_edges_product, Rings, SmoothStats, MAX_HALVINGS};
 
 /// Normal (unnormalised) and [`min_angle_quality`] of a face, sharing the edge vectors.
 pub(super) fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
@@ -15,13 +15,7 @@ pub(super) fn face_shape(pos: &[Point3], t: [u32; 3]) -> (Point3, f64) {
     let (ab, ac) = (sub(b, a), sub(c, a));
     let n = cross(ab, ac);
     let (la, lb, lc) = (norm2(sub(c, b)), norm2(ac), norm2(ab));
-    let prod = if la <= lb && la <= lc {
-        lb * lc
-    } else if lb <= lc {
-        la * lc
-    } else {
-        la * lb
-    };
+    let prod = longer_edges_product(la, lb, lc);
     (n, if prod > 0.0 { norm2(n) / prod } else { 0.0 })
 }
 

@@ -358,19 +358,24 @@ pub fn undo_new_flips(
     }
 }
 
+/// The product of the two larger of three squared edge lengths (those beside the smallest angle).
+pub(super) fn longer_edges_product(la: f64, lb: f64, lc: f64) -> f64 {
+    if la <= lb && la <= lc {
+        lb * lc
+    } else if lb <= lc {
+        la * lc
+    } else {
+        la * lb
+    }
+}
+
 /// sin² of a face's smallest angle (the corner opposite the shortest edge): |n|² / (|e1|²·|e2|²)
 /// with e1, e2 the two longer edges. Monotone in the angle on [0°, 60°], where a smallest angle
 /// always is, and free of trigonometry. 0 for a degenerate face.
 pub fn min_angle_quality(a: Point3, b: Point3, c: Point3) -> f64 {
     let (la, lb, lc) = (norm2(sub(b, c)), norm2(sub(c, a)), norm2(sub(a, b)));
     let n = norm2(cross(sub(b, a), sub(c, a)));
-    let prod = if la <= lb && la <= lc {
-        lb * lc
-    } else if lb <= lc {
-        la * lc
-    } else {
-        la * lb
-    };
+    let prod = longer_edges_product(la, lb, lc);
     if prod > 0.0 {
         n / prod
     } else {
