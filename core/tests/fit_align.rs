@@ -6,7 +6,8 @@
 
 use meshwork_core::fit::curves::CurveNetwork;
 use meshwork_core::fit::testdata::{
-    bend, plane_sections, section_regions, sweep_planes, thin_network, to_unit_box,
+    bend, feature_curves, plane_sections, section_regions, sharp_edges, sweep_planes, thin_network,
+    to_unit_box, TruthSurface,
 };
 use meshwork_core::fit::{align, run, FitParams};
 use meshwork_core::geometry::{dist, Aabb};
@@ -221,18 +222,48 @@ fn a_known_rotation_scale_and_translation_is_recovered() {
     assert_eq!(out.report["segments_as_edges"].as_f64(), Some(1.0));
 }
 
-/// Woody is flat and nearly symmetric: turned over, it fits its sections almost as well, and
-/// the fit must say so (before: it silently chose the mirror image, 5 of 11 regions).
+/// Woody is flat and nearly symmetric: placed anywhere but on its curves, turned over it fits its
+/// sections almost as well, and the fit must say so (before: it silently chose the mirror image, 5
+/// of 11 regions). The template is turned a quarter about z and moved off the curves, so the pose
+/// as placed is no ICP start (the next test has it on its curves).
 #[test]
 fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
     let m = shared("woody");
-    let template = subdivide_midpoint(&m, 1);
+    let mut template = subdivide_midpoint(&m, 1);
+    for p in &mut template.positions {
+        *p = [3.0 - p[1], p[0], p[2]];
+    }
     let params =
         FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
     let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
     let a = &out.report["alignment"];
     eprintln!("alignment {a}");
     assert_eq!(a["ambiguous"], true, "{a}");
+}
+
+/// The same figure placed on its (bent) sections keeps the pose it has: the placed pose is an ICP
+/// start and its warp follows the bend 1.5× closer than the mirror pose's, so the choice is the
+/// truth and not ambiguous. Truth: the template carried by the known bend; at most 1% of the output
+/// faces may face against it (the mirror pose turns nearly all of them).
+#[test]
+fn a_flat_nearly_symmetric_figure_on_its_curves_keeps_its_pose() {
+    let m = shared("woody");
+    let template = subdivide_midpoint(&m, 1);
+    let mut truth = template.clone();
+    for p in &mut truth.positions {
+        *p = bend(*p, 1.0);
+    }
+    let params =
+        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
+    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("alignment {a}");
+    assert_eq!(a["ambiguous"], false, "{a}");
+    let o = &out.meshes[0];
+    let against = TruthSurface::new(&truth).faces_against(o);
+    let faces = o.faces.len();
+    eprintln!("{against} of {faces} faces against the bent template");
+    assert!(100 * against <= faces, "{against} of {faces} faces turned over");
 }
 
 /// A flat open figure fitted to its own sections (the alligator, repaired, holes left open): the
@@ -257,4 +288,31 @@ fn a_flat_figure_under_its_own_sections_keeps_its_side_up() {
     let against = TruthSurface::new(&m).faces_against(o);
     eprintln!("{against} of {} faces against the truth; alignment {}", tris.len(), out.report["alignment"]);
     assert!(100 * against <= tris.len(), "{against} of {} faces turned over", tris.len());
+}
+
+/// A template placed where its curves are stays there. The curves are rocker-arm's sharp edges
+/// over 50° (`testdata::feature_curves`, 2-point polylines welded by the reader): they crowd at the
+/// part's rims and bores, so their principal axes are unlike the template's and no PCA start came
+/// near the pose the template already has. Before the placed pose was an ICP start, the search
+/// chose poses turned 100–170° away, and here 4,083 of 21,110 output faces faced against the part,
+/// a vertex 0.42 off it (session 23). Truth: the template itself, which the curves lie on.
+#[test]
+fn a_template_placed_on_its_feature_lines_stays_in_place() {
+    let template = shared("rocker-arm");
+    let (edges, regions) = sharp_edges(&template, 50.0);
+    assert!(edges.len() > 100, "rocker-arm has {} sharp edges", edges.len());
+    let curves = feature_curves(&template, 50.0);
+    let out = run(vec![template.clone(), curves], &FitParams::default(), &Progress::new()).expect("fit");
+    let r = &out.report;
+    eprintln!("alignment {}", r["alignment"]);
+    assert_eq!(r["alignment"]["method"], "pca_icp");
+    let truth = TruthSurface::new(&template);
+    let m = &out.meshes[0];
+    let against = truth.faces_against(m);
+    let faces = m.faces.len();
+    let far = truth.max_distance(m);
+    eprintln!("{against} of {faces} faces against the template; farthest vertex {far:.2e}");
+    assert!(against * 200 < faces, "{against} of {faces} output faces face against the template");
+    assert!(far < 5e-3, "an output vertex is {far:.2e} off the template (diagonal ~1.4)");
+    assert_eq!(r["regions"].as_u64(), Some(regions as u64), "regions vs the sharp edges' count");
 }

@@ -14,7 +14,7 @@ use meshwork_core::{Error, Progress};
 use crate::support::{case, read_as, shared, to_unit_box, Case, Expect};
 
 /// The repaired `name` in the sections' unit-box frame, simplified to `vertices`.
-fn coarse_copy(name: &str, vertices: usize) -> Result<Mesh, Error> {
+pub fn coarse_copy(name: &str, vertices: usize) -> Result<Mesh, Error> {
     let raw = read_as(&shared(name), "x.obj")?;
     let params = RepairParams { fill_holes: false, ..Default::default() };
     let mut fixed = repair::run(raw, &params, &Progress::new())?.meshes.remove(0);

@@ -14,7 +14,7 @@
 //!
 //! Run from the repository root:
 //! `CARGO_TARGET_DIR=/work/tr-fit-unseen cargo run --release -p meshwork-core --example sweep_unseen [NAME…]`
-//! (NAME: any part of a case name; `SWEEP_DETAIL=1` also prints the flip counts by stage, the
+//! (NAME: any part of a case name; `SWEEP_DUMP=DIR` writes the inputs, the output and the report there; `SWEEP_DETAIL=1` also prints the flip counts by stage, the
 //! untangling, clean-up and re-triangulation reports; `SWEEP_PARAMS='{"smooth": false}'` merges
 //! parameters into every fitting case; the round icosphere fitted to a flattened ellipsoid's
 //! sections, which took minutes, now ends in seconds with the face guard's error.)
@@ -26,7 +26,9 @@
 mod check;
 mod coarse;
 mod densities;
+mod features;
 mod formats;
+mod genus;
 mod layouts;
 mod networks;
 mod pair_counts;
@@ -62,6 +64,8 @@ fn cases() -> Vec<Case> {
         densities::densities(),
         pair_counts::pair_counts(),
         sources::sources(),
+        genus::genus(),
+        features::features(),
     ]
     .into_iter()
     .flatten()
@@ -120,7 +124,17 @@ fn main() {
                     m.extend(e);
                 }
             }
-            job::run(JobKind::Fit, inputs, params, &Progress::new()).map(|o| (keep, o))
+            let out = job::run(JobKind::Fit, inputs, params, &Progress::new());
+            // SWEEP_DUMP also gets the output and its report (the CLI's reading of the dumped
+            // inputs need not fit the same, bit for bit).
+            if let (Ok(dir), Ok(o)) = (std::env::var("SWEEP_DUMP"), &out) {
+                use meshwork_core::io::{write, Format};
+                if let Ok(bytes) = write(&o.meshes[0], Format::Obj) {
+                    let _ = std::fs::write(format!("{dir}/out.obj"), bytes);
+                }
+                let _ = std::fs::write(format!("{dir}/report.json"), o.report.to_string());
+            }
+            out.map(|o| (keep, o))
         }));
         let secs = t.elapsed().as_secs_f64();
         let line = match (&c.expect, result) {

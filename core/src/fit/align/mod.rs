@@ -1,7 +1,8 @@
 //! Automatic initial alignment when the user gives no correspondence pairs: PCA of the template
 //! vertices against the curve points for a start, then similarity ICP (rotation, translation,
 //! uniform scale; Horn's quaternion method). PCA axes have sign ambiguities, so the four proper
-//! sign choices are each refined by ICP and the best fit wins. Symmetric templates can still
+//! sign choices are each refined by ICP and the best fit wins; the template as placed is a start
+//! too when the curves already lie on it. Symmetric templates can still
 //! align in more than one way: pairs are the reliable route (the seed always uses them).
 
 use crate::error::Result;
@@ -246,7 +247,8 @@ pub fn pca_icp(
 /// [`SAME_POSE_DEG`] apart), best ICP score first.
 ///
 /// Candidates: every proper rotation taking the template's principal axes onto the curves'
-/// (6 axis orders × 4 sign choices = 24). The axis *order* matters as much as the signs: the
+/// (6 axis orders × 4 sign choices = 24), and the template as placed when the curves already lie
+/// on it ([`PLACED_NEAR`]). The axis *order* matters as much as the signs: the
 /// curves sample the surface unevenly (sections along one axis only, a partial network), so
 /// their spreads need not rank like the template's, and templates with two similar spreads
 /// (a flat figure, a round body) swap axes under any small change. Each candidate gets a short
@@ -296,6 +298,20 @@ pub fn pca_icp_candidates(
             scored.push((score, m));
         }
     }
+    // The template as placed, when the curves already lie on it: a user who drew the curves on the
+    // template expects that pose, and curves that sample the surface unevenly (feature lines, a
+    // partial network) have principal axes unlike the template's, so no PCA start need come near
+    // it. A template placed elsewhere is no start: ICP from there ends wherever the nearest
+    // vertices pull it (a sphere at the origin against a thin shape at (0.5, 0.5, 0.5) shrank
+    // into a pose no PCA start gives, and the fit then cut 10 of 20 regions).
+    let placed = Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] };
+    if icp(&coarse_template, &coarse_tree, &few, placed, 0, &[], 0, progress)?.1
+        <= PLACED_NEAR * diagonal(template)
+    {
+        let (m, score) =
+            icp(&coarse_template, &coarse_tree, &few, placed, iterations.min(10), &[], 0, progress)?;
+        scored.push((score, m));
+    }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     let starts =
         distinct(scored.into_iter().map(|(s, m)| Candidate { sim: m, icp_rms: s, contender: false }), keep);
@@ -317,6 +333,15 @@ pub fn pca_icp_candidates(
     }
     refined.sort_by(|a, b| b.contender.cmp(&a.contender).then(a.icp_rms.total_cmp(&b.icp_rms)));
     Ok(distinct(refined.into_iter(), usize::MAX))
+}
+
+/// The template as placed is an ICP start when the curve points' RMS distance to its nearest
+/// vertices is at most this fraction of its bounding-box diagonal.
+const PLACED_NEAR: f64 = 0.1;
+
+/// The bounding-box diagonal of `p` (0 when empty).
+fn diagonal(p: &[Point3]) -> f64 {
+    crate::geometry::Aabb::of(p).map_or(0.0, |b| b.diagonal())
 }
 
 /// Poses whose ICP score (against the template subset) is within this factor of the best are

@@ -7,6 +7,7 @@
 //!   polylines, jitter, arcs whose ends miss;
 //! - [`templates`]: templates beyond the icosphere (cylinder, paraboloid with a hole, n-gon sphere)
 //!   and mesh edits (holes, two meshes as one, a zero-area face);
+//! - [`features`]: a mesh's sharp edges as a feature-line network, and the regions they cut;
 //! - [`checks`]: checks of an output against the truth (faces turned against its normal);
 //! - [`heldout`]: other smooth maps and oblique planes, the held-out family of the deformed sweep;
 //! - [`files`]: curve files as other programs write them (glTF lines with and without node
@@ -16,6 +17,7 @@
 
 pub mod checks;
 pub mod curves;
+pub mod features;
 pub mod files;
 pub mod heldout;
 pub mod regions;
@@ -24,6 +26,7 @@ pub mod templates;
 
 pub use checks::*;
 pub use curves::*;
+pub use features::*;
 pub use files::*;
 pub use heldout::*;
 pub use regions::*;

@@ -1,0 +1,42 @@
+//! Feature-line networks (`testdata::feature_curves`): the sharp edges of a CAD or scanned mesh,
+//! edge by edge as two-point polylines the reader must weld, fitted onto a coarse copy of the same
+//! mesh placed where the curves are (as a user who drew the curves on the template has it). Unlike
+//! plane sections, feature lines end in the open and meet at corners of any valence, and they sample
+//! the surface so unevenly that their principal axes are unlike the template's.
+//!
+//! The hand count of the regions: `testdata::sharp_edges` on the source.
+
+use serde_json::json;
+
+use meshwork_core::fit::testdata::{feature_curves, sharp_edges};
+use meshwork_core::mesh::Mesh;
+use meshwork_core::repair::{self, RepairParams};
+use meshwork_core::{Error, Progress};
+
+use crate::coarse::coarse_copy;
+use crate::support::{case, read_as, shared, to_unit_box, Case, Expect};
+
+/// The repaired `name` in the unit box (the frame of `coarse_copy`).
+fn source(name: &str) -> Result<Mesh, Error> {
+    let raw = read_as(&shared(name), "x.obj")?;
+    let params = RepairParams { fill_holes: false, ..Default::default() };
+    let mut fixed = repair::run(raw, &params, &Progress::new())?.meshes.remove(0);
+    to_unit_box(&mut fixed);
+    Ok(fixed)
+}
+
+pub fn features() -> Vec<Case> {
+    let mut out = Vec::new();
+    for (name, deg) in [("fandisk", 40.0), ("rocker-arm", 50.0)] {
+        let regions = source(name).ok().map(|m| sharp_edges(&m, deg).1);
+        for vertices in [1000, 3000] {
+            out.push(case(
+                &format!("coarse {name} ({vertices} vertices) vs its feature lines over {deg}°"),
+                move || Ok(vec![coarse_copy(name, vertices)?, feature_curves(&source(name)?, deg)]),
+                json!({}),
+                Expect::Fit(regions),
+            ));
+        }
+    }
+    out
+}
