@@ -5,9 +5,72 @@
 
 use std::collections::HashMap;
 
-use crate::mesh::Point3;
+use crate::error::Result;
+use crate::job::Progress;
+use crate::mesh::{Mesh, Point3};
 
 use super::insert::barycentric;
+
+/// The labels of the output faces: the region, and the template group when the template has
+/// several (kept through the fine stage's splits, then by [`after_retriangulation`] for every face
+/// list the later stages make).
+pub struct Labelling {
+    /// The template has several groups, every face fanned (the groups are carried).
+    pub keep_groups: bool,
+    /// The fine stage's triangles and their template groups (empty when no groups are kept).
+    fine_tris: Vec<[u32; 3]>,
+    fine_groups: Vec<u32>,
+}
+
+impl Labelling {
+    /// From the fine stage's mesh (`tris`, positions `pos` before the fine deformation; `parents`
+    /// of the vertices it added after the template's).
+    pub fn new(
+        template: &Mesh,
+        template_tris: &[[u32; 3]],
+        tris: &[[u32; 3]],
+        pos: &[Point3],
+        parents: &[[(u32, f64); 3]],
+    ) -> Labelling {
+        let keep_groups = template.groups.len() > 1
+            && template.faces.iter().map(|f| f.len().saturating_sub(2)).sum::<usize>() == template_tris.len();
+        if !keep_groups {
+            return Labelling { keep_groups, fine_tris: Vec::new(), fine_groups: Vec::new() };
+        }
+        let template_groups: Vec<u32> = (0..template.faces.len())
+            .flat_map(|i| {
+                std::iter::repeat_n(template.faces.group(i), template.faces.arity(i).saturating_sub(2))
+            })
+            .collect();
+        let fine_groups =
+            after_refinement(tris, pos, template_tris, &template_groups, template.vertex_count(), parents);
+        Labelling { keep_groups, fine_tris: tris.to_vec(), fine_groups }
+    }
+
+    /// Template group of each face of `tris` (over `n` vertices); all 0 when no groups are kept.
+    pub fn groups_of(&self, tris: &[[u32; 3]], n: usize) -> Vec<u32> {
+        if self.keep_groups {
+            after_retriangulation(&self.fine_tris, &self.fine_groups, tris, n)
+        } else {
+            vec![0; tris.len()]
+        }
+    }
+
+    /// Regions of `tris` (cut along `curve_edges`), their count, and the template groups (`old`
+    /// unchanged when no groups are kept: nothing reads them then).
+    pub fn relabel(
+        &self,
+        tris: &[[u32; 3]],
+        curve_edges: &super::untangle::EdgeSet,
+        n: usize,
+        old: Vec<u32>,
+        progress: &Progress,
+    ) -> Result<(Vec<u32>, usize, Vec<u32>)> {
+        let (region, count) = super::partition::regions_polled(tris, curve_edges, progress)?;
+        let tg = if self.keep_groups { self.groups_of(tris, n) } else { old };
+        Ok((region, count, tg))
+    }
+}
 
 /// Template group of each triangle of `tris` (the fine stage's mesh, positions `pos` before the
 /// fine deformation). `parents[i]` are the weighted parents of vertex `nv0 + i`.

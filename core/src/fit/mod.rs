@@ -108,18 +108,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // The template's triangles, fanned once: the working copy below starts from them, and the
     // face-growth base, the group transfer and the report measure them.
     let template_tris = crate::shapes::fan_triangles(&template.faces);
-    let mut tris = stages.run(progress, "validate", || {
-        let tris = template_tris.clone();
-        if tris.is_empty() {
-            return Err(Error::params("template", "the template has no faces"));
-        }
-        // Fails early, naming the face, on a non-manifold or inconsistently oriented template.
-        let face_of: Vec<usize> = (0..template.faces.len())
-            .flat_map(|i| std::iter::repeat_n(i, template.faces.arity(i).saturating_sub(2)))
-            .collect();
-        trimesh::check_oriented_manifold_faces(&tris, Some(&face_of))?;
-        Ok(tris)
-    })?;
+    let mut tris = stages.run(progress, "validate", || validated(&template, &template_tris))?;
     let given_diag = Aabb::of(&template.positions).map(|b| b.diagonal()).unwrap_or(0.0);
     let mut pos = template.positions.clone();
     // The template's normals, pushed forward by every map the coarse and fine stages apply: the
@@ -166,59 +155,17 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
     let (fine, refined) = stages.run(progress, "fine", || {
-        let clock = std::time::Instant::now();
-        let pair_fixed = coarse.pair_fixed(&params.pairs);
-        let levels = params.approach_levels as usize;
-        let limit = reach.limit();
-        let approach = approach::approach(
+        fine_stage(
             &mut pos,
             &mut tris,
             &mut parents,
-            &net,
-            &pair_fixed,
-            params.kernel,
-            levels,
-            limit,
-            params.thin_rim_feet,
             &mut orientation,
-            progress,
-        )?;
-        let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
-        // Faces of the approached template under dense curves are split, so no face has to hold
-        // many curve vertices (after the approach: feet of curves still far from a coarse surface
-        // cluster where it is closest, which is no density of the curves).
-        let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
-        let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
-        // One closest-point search (a BVH over the approached template) for the refinement's
-        // density check and the insertion's feet; the refinement replaces it when it splits.
-        let mut search = insert::FootSearch::new_polled(&pos, &tris, progress)?;
-        let mut refined = refine::refine_near_curves(
-            &mut pos,
-            &mut tris,
-            &net,
-            &mut search,
-            dense,
-            max,
-            budget,
-            &mut parents,
-            progress,
-        )?;
-        refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
-        let mut fine = fine_dispatch(
-            &mut pos,
-            &mut tris,
             &net,
             &coarse,
             params,
             reach,
-            &mut parents,
-            search,
-            &mut orientation,
             progress,
-        )?;
-        fine.report.approach = Some(approach);
-        fine.report.approach_ms = approach_ms;
-        Ok((fine, refined))
+        )
     })?;
 
     // Folds the fine deformation left (faces turned against the surface before it) are undone by
@@ -239,26 +186,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let tris = mesh.live_triangles();
 
     // The template's own face groups, when it has several, are intersected with the regions.
-    let keep_groups = template.groups.len() > 1
-        && template.faces.iter().map(|f| f.len().saturating_sub(2)).sum::<usize>() == template_tris.len();
-    let fine_groups = if keep_groups {
-        let template_groups: Vec<u32> = (0..template.faces.len())
-            .flat_map(|i| {
-                std::iter::repeat_n(template.faces.group(i), template.faces.arity(i).saturating_sub(2))
-            })
-            .collect();
-        groups::after_refinement(
-            &tris,
-            &pos,
-            &template_tris,
-            &template_groups,
-            template.vertex_count(),
-            &parents,
-        )
-    } else {
-        Vec::new()
-    };
-    let fine_tris = if keep_groups { tris.clone() } else { Vec::new() };
+    let labelling = groups::Labelling::new(&template, &template_tris, &tris, &pos, &parents);
+    let keep_groups = labelling.keep_groups;
     let fine_positions = mesh.pos.clone();
     let mut reference_normals = report::vertex_normals(&fine_positions, &tris);
     let mut realised = stages.run(progress, "retriangulate", || {
@@ -271,12 +200,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     for a in &realised.added {
         push_edge_normal(&mut reference_normals, a);
     }
-    let mut curve_edges = untangle::EdgeSet::default();
-    for c in &realised.chains {
-        for p in c.windows(2) {
-            curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
-        }
-    }
+    let mut curve_edges = chain_edges(&realised.chains);
     // Folds made by snapping vertices onto segments and by the re-triangulated strips, against the
     // fine surface; chain vertices stay fixed and curve edges locked.
     let untangle_retri = stages.run(progress, "untangle_retriangulated", || {
@@ -306,11 +230,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let (region0, mut region_count) = stages
         .run(progress, "partition", || partition::regions_polled(&retri_tris, &curve_edges, progress))?;
     // Label of every face id: region × template group, kept by the clean-up.
-    let group0 = if keep_groups {
-        groups::after_retriangulation(&fine_tris, &fine_groups, &retri_tris, mesh.pos.len())
-    } else {
-        vec![0; retri_tris.len()]
-    };
+    let group0 = labelling.groups_of(&retri_tris, mesh.pos.len());
     let mut labels = vec![u64::MAX; mesh.tris.len()];
     for ((f, &r), &g) in mesh.alive_faces().collect::<Vec<_>>().into_iter().zip(&region0).zip(&group0) {
         labels[f as usize] = ((r as u64) << 32) | g as u64;
@@ -344,19 +264,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     let mut realised = realised;
     if !cleaned.removed_vertices.is_empty() {
         // Chain vertices the clean-up removed leave their chains (their neighbours are joined).
-        let mut gone = vec![false; mesh.pos.len()];
-        for &v in &cleaned.removed_vertices {
-            gone[v as usize] = true;
-        }
-        for c in realised.chains.iter_mut() {
-            c.retain(|&v| !gone[v as usize]);
-        }
-        curve_edges.clear();
-        for c in &realised.chains {
-            for p in c.windows(2) {
-                curve_edges.insert((p[0].min(p[1]), p[0].max(p[1])));
-            }
-        }
+        leave_chains(&mut realised.chains, &cleaned.removed_vertices, mesh.pos.len());
+        curve_edges = chain_edges(&realised.chains);
     }
     let mut out_tris = mesh.live_triangles();
     let mut region: Vec<u32> = mesh.alive_faces().map(|f| (labels[f as usize] >> 32) as u32).collect();
@@ -364,7 +273,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // (the clean-up never edits across a group border, but a face re-triangulation made across
     // one carries a majority label that is not the geometric truth for its pieces).
     let mut tg: Vec<u32> = if keep_groups && cleaned.flips + cleaned.collapses > 0 {
-        groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, mesh.pos.len())
+        labelling.groups_of(&out_tris, mesh.pos.len())
     } else {
         mesh.alive_faces().map(|f| labels[f as usize] as u32).collect()
     };
@@ -424,10 +333,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
             // Flipped edges are never curve edges, so regions are unchanged; the labels are
             // recomputed for the new face list.
             out_tris = mesh.live_triangles();
-            (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
-            if keep_groups {
-                tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
-            }
+            (region, region_count, tg) =
+                labelling.relabel(&out_tris, &curve_edges, out_pos.len(), tg, progress)?;
         }
         Some(s)
     } else {
@@ -453,20 +360,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     })?;
     if !degenerate.removed_vertices.is_empty() {
         // A collapsed chain vertex leaves its chain (its neighbours were joined by the collapse).
-        let mut gone = vec![false; mesh.pos.len()];
-        for &v in &degenerate.removed_vertices {
-            gone[v as usize] = true;
-        }
-        for c in realised.chains.iter_mut() {
-            c.retain(|&v| !gone[v as usize]);
-        }
+        leave_chains(&mut realised.chains, &degenerate.removed_vertices, mesh.pos.len());
     }
     if degenerate.flips + degenerate.collapses > 0 {
         out_tris = mesh.live_triangles();
-        (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
-        if keep_groups {
-            tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
-        }
+        (region, region_count, tg) =
+            labelling.relabel(&out_tris, &curve_edges, out_pos.len(), tg, progress)?;
     }
     // The last repair, on the faces the report's count calls turned and only those (the stages
     // before judge against the surface's vertex normals, which at a sharp crease of small faces
@@ -520,10 +419,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
         // Flipped and split edges are never curve edges: the regions are the same, relabelled for
         // the new face list.
         out_tris = turned_tris;
-        (region, region_count) = partition::regions_polled(&out_tris, &curve_edges, progress)?;
-        if keep_groups {
-            tg = groups::after_retriangulation(&fine_tris, &fine_groups, &out_tris, out_pos.len());
-        }
+        (region, region_count, tg) =
+            labelling.relabel(&out_tris, &curve_edges, out_pos.len(), tg, progress)?;
     }
     let angles_after = report::angle_stats(&out_pos, &out_tris);
 
@@ -551,34 +448,8 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
     // Output mesh: one group per region (per region × template group when the template had
     // groups), the curves as vertex chains.
-    // Faces in group order (stable), so an OBJ has one `g` block per group, not one per change.
-    let (out_tris, region, tg) = {
-        let mut order: Vec<usize> = (0..out_tris.len()).collect();
-        order.sort_by_key(|&i| (region[i], if keep_groups { tg[i] } else { 0 }));
-        let tg = if keep_groups { order.iter().map(|&i| tg[i]).collect() } else { tg };
-        (
-            order.iter().map(|&i| out_tris[i]).collect::<Vec<_>>(),
-            order.iter().map(|&i| region[i]).collect::<Vec<_>>(),
-            tg,
-        )
-    };
-    let mut faces = Faces::with_capacity(out_tris.len(), out_tris.len() * 3);
-    let mut group_names: Vec<String> = (0..region_count).map(|i| format!("region_{i}")).collect();
-    if keep_groups {
-        let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-        group_names.clear();
-        for ((t, &r), &g) in out_tris.iter().zip(&region).zip(&tg) {
-            let gid = *id.entry((r, g)).or_insert_with(|| {
-                group_names.push(format!("region_{r}/{}", template.group_name(g)));
-                (group_names.len() - 1) as u32
-            });
-            faces.push(t, gid);
-        }
-    } else {
-        for (t, &g) in out_tris.iter().zip(&region) {
-            faces.push(t, g);
-        }
-    }
+    let (out_tris, faces, group_names) =
+        grouped_faces(out_tris, &region, region_count, keep_groups.then_some((tg.as_slice(), &template)));
     let mut out = Mesh::new(out_pos, faces);
     out.uvs = template.uvs.as_ref().map(|uv| {
         // In the order the vertices were made and moved: fine-stage splits, fine untangling,
@@ -620,11 +491,13 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // Every vertex moved over the surface (its UV re-read where it landed), in the numbering
     // before the clean-up: re-triangulation snaps, untangling, smoothing.
     let mut moved_vertices: Vec<u32> = realised.uv_moves.iter().map(|m| m.vertex).collect();
-    for s in [Some(&untangle_fine), Some(&untangle_retri), untangle_smoothed.as_ref()].into_iter().flatten() {
-        moved_vertices.extend(s.uv_batches.iter().flatten().map(|m| m.vertex));
+    let batches = [Some(&untangle_fine.uv_batches), Some(&untangle_retri.uv_batches)]
+        .into_iter()
+        .chain([untangle_smoothed.as_ref().map(|s| &s.uv_batches), Some(&turned.uv_batches)]);
+    for b in batches.flatten() {
+        moved_vertices.extend(b.iter().flatten().map(|m| m.vertex));
     }
     moved_vertices.extend_from_slice(&smooth_moved);
-    moved_vertices.extend(turned.uv_batches.iter().flatten().map(|m| m.vertex));
     moved_vertices.sort_unstable();
     moved_vertices.dedup();
     let mut report = serde_json::json!({
@@ -694,6 +567,125 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     report["refine"] = serde_json::to_value(&refined).unwrap_or_default();
     report["zero_area_faces"] = serde_json::to_value(&degenerate).unwrap_or_default();
     Ok(Output { meshes: vec![out], report, ..Default::default() })
+}
+
+/// Stage 3: the approach levels, the refinement under dense curves, then the fine RBF by the
+/// matching rule ([`fine_dispatch`]). `parents` gets the weighted parents of every vertex added.
+#[allow(clippy::too_many_arguments)]
+fn fine_stage(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    orientation: &mut orientation::Orientation,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    reach: fine::Reach,
+    progress: &Progress,
+) -> Result<(Fine, refine::RefineReport)> {
+    let clock = std::time::Instant::now();
+    let pair_fixed = coarse.pair_fixed(&params.pairs);
+    let levels = params.approach_levels as usize;
+    let limit = reach.limit();
+    let approach = approach::approach(
+        pos,
+        tris,
+        parents,
+        net,
+        &pair_fixed,
+        params.kernel,
+        levels,
+        limit,
+        params.thin_rim_feet,
+        orientation,
+        progress,
+    )?;
+    let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
+    // Faces of the approached template under dense curves are split, so no face has to hold
+    // many curve vertices (after the approach: feet of curves still far from a coarse surface
+    // cluster where it is closest, which is no density of the curves).
+    let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+    let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
+    // One closest-point search (a BVH over the approached template) for the refinement's
+    // density check and the insertion's feet; the refinement replaces it when it splits.
+    let mut search = insert::FootSearch::new_polled(pos, tris, progress)?;
+    let mut refined =
+        refine::refine_near_curves(pos, tris, net, &mut search, dense, max, budget, parents, progress)?;
+    refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
+    let mut fine =
+        fine_dispatch(pos, tris, net, coarse, params, reach, parents, search, orientation, progress)?;
+    fine.report.approach = Some(approach);
+    fine.report.approach_ms = approach_ms;
+    Ok((fine, refined))
+}
+
+/// The template's triangles (`tris`, fanned from its faces), checked: some faces, an oriented
+/// manifold (the error names the template's face, not the fanned triangle).
+fn validated(template: &Mesh, tris: &[[u32; 3]]) -> Result<Vec<[u32; 3]>> {
+    if tris.is_empty() {
+        return Err(Error::params("template", "the template has no faces"));
+    }
+    let face_of: Vec<usize> = (0..template.faces.len())
+        .flat_map(|i| std::iter::repeat_n(i, template.faces.arity(i).saturating_sub(2)))
+        .collect();
+    trimesh::check_oriented_manifold_faces(tris, Some(&face_of))?;
+    Ok(tris.to_vec())
+}
+
+/// The output's faces in group order (stable: an OBJ gets one `g` block per group, not one per
+/// change), their groups and the group names: one group per region, or per region × template
+/// group when `template_groups` (each face's group, and the template naming them) is given.
+fn grouped_faces(
+    tris: Vec<[u32; 3]>,
+    region: &[u32],
+    region_count: usize,
+    template_groups: Option<(&[u32], &Mesh)>,
+) -> (Vec<[u32; 3]>, Faces, Vec<String>) {
+    let tg = |i: usize| template_groups.map_or(0, |(g, _)| g[i]);
+    let mut order: Vec<usize> = (0..tris.len()).collect();
+    order.sort_by_key(|&i| (region[i], tg(i)));
+    let sorted: Vec<[u32; 3]> = order.iter().map(|&i| tris[i]).collect();
+    let mut faces = Faces::with_capacity(sorted.len(), sorted.len() * 3);
+    let Some((_, template)) = template_groups else {
+        for (t, &i) in sorted.iter().zip(&order) {
+            faces.push(t, region[i]);
+        }
+        return (sorted, faces, (0..region_count).map(|i| format!("region_{i}")).collect());
+    };
+    let mut names = Vec::new();
+    let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for (t, &i) in sorted.iter().zip(&order) {
+        let (r, g) = (region[i], tg(i));
+        let gid = *id.entry((r, g)).or_insert_with(|| {
+            names.push(format!("region_{r}/{}", template.group_name(g)));
+            (names.len() - 1) as u32
+        });
+        faces.push(t, gid);
+    }
+    (sorted, faces, names)
+}
+
+/// The chain edges of `chains`, each as (smaller, larger) vertex.
+fn chain_edges(chains: &[Vec<u32>]) -> untangle::EdgeSet {
+    let mut edges = untangle::EdgeSet::default();
+    for c in chains {
+        for p in c.windows(2) {
+            edges.insert((p[0].min(p[1]), p[0].max(p[1])));
+        }
+    }
+    edges
+}
+
+/// Takes the `removed` vertices (of `n`) out of the chains they were on: an edit that removed one
+/// joined its two chain neighbours.
+fn leave_chains(chains: &mut [Vec<u32>], removed: &[u32], n: usize) {
+    let mut gone = vec![false; n];
+    for &v in removed {
+        gone[v as usize] = true;
+    }
+    for c in chains.iter_mut() {
+        c.retain(|&v| !gone[v as usize]);
+    }
 }
 
 /// Distance helper kept here for the report.
