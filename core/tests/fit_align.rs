@@ -316,3 +316,36 @@ fn a_template_placed_on_its_feature_lines_stays_in_place() {
     assert!(far < 5e-3, "an output vertex is {far:.2e} off the template (diagonal ~1.4)");
     assert_eq!(r["regions"].as_u64(), Some(regions as u64), "regions vs the sharp edges' count");
 }
+
+/// The report says where the chosen pose is against the template as given (`alignment.placed`).
+/// Spot in place under its own sections: the pose stays (turned < 2°). Under its sections turned
+/// 180° about the x axis through the box centre: the curves still lie within 0.1 of the diagonal
+/// of the template as given, and the search finds the turned pose (it fits far better). Truth: the
+/// 180° turn applied.
+#[test]
+fn the_report_says_how_far_the_pose_turned_from_the_template_as_given() {
+    let m = shared("spot");
+    let template = subdivide_midpoint(&m, 1);
+    let curves = plane_sections(&m, &sweep_planes(&m));
+    let out =
+        run(vec![template.clone(), curves.clone()], &FitParams::default(), &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("in place: {}", a["placed"]);
+    assert_eq!(a["placed"]["on_curves"], true, "{a}");
+    assert!(a["placed"]["turned_deg"].as_f64().expect("turned") < 2.0, "{a}");
+    assert!((a["placed"]["scale"].as_f64().expect("scale") - 1.0).abs() < 0.01, "{a}");
+
+    let b = Aabb::of(&m.positions).expect("box");
+    let c = b.center();
+    let mut turned = curves;
+    for p in &mut turned.positions {
+        *p = [p[0], 2.0 * c[1] - p[1], 2.0 * c[2] - p[2]];
+    }
+    let out = run(vec![template, turned], &FitParams::default(), &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("turned: {}", a["placed"]);
+    assert_eq!(a["placed"]["on_curves"], true, "the test needs curves near the template as given: {a}");
+    assert!(a["placed"]["turned_deg"].as_f64().expect("turned") > 170.0, "{a}");
+    // The turn is about the box centre, which the template's centre is near: it hardly moves.
+    assert!(a["placed"]["moved_relative"].as_f64().expect("moved") < 0.05, "{a}");
+}

@@ -35,6 +35,44 @@ pub struct CoarseReport {
     pub ambiguous: bool,
     /// Why `ambiguous` is set, in words, for the user.
     pub warning: Option<String>,
+    /// `pca_icp`: the chosen pose against the template as placed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub placed: Option<PlacedReport>,
+}
+
+/// The automatic alignment's pose against the template as it was given. A template that lay on
+/// the curves (`on_curves`) and was turned far (`turned_deg`) may have been placed on purpose:
+/// `alignment: "none"` keeps it. No warning: a symmetric template (a sphere) is turned among
+/// equally good poses all the time (68 of `sweep_unseen`'s rows), and the poses' scores do not say
+/// which turns matter.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlacedReport {
+    /// RMS distance of the curve points to the template's nearest vertices as placed, over the
+    /// template's bounding-box diagonal.
+    pub rms_relative: f64,
+    /// The curves lay on the template as placed (`rms_relative` ≤ [`align::PLACED_NEAR`]); the
+    /// pose as placed was then one of the search's starts.
+    pub on_curves: bool,
+    /// Rotation of the chosen pose from the pose as placed, degrees.
+    pub turned_deg: f64,
+    /// Its scale.
+    pub scale: f64,
+    /// How far it moved the template's centre, over the template's bounding-box diagonal.
+    pub moved_relative: f64,
+}
+
+impl PlacedReport {
+    fn new(rms_relative: f64, template: &[Point3], chosen: &align::Similarity) -> PlacedReport {
+        let diag = Aabb::of(template).map_or(0.0, |b| b.diagonal()).max(f64::MIN_POSITIVE);
+        let centre = Aabb::of(template).map_or([0.0; 3], |b| b.center());
+        PlacedReport {
+            rms_relative,
+            on_curves: rms_relative <= align::PLACED_NEAR,
+            turned_deg: align::rotation_angle_deg(&chosen.r, &align::Similarity::PLACED.r),
+            scale: chosen.s,
+            moved_relative: dist(chosen.apply(centre), centre) / diag,
+        }
+    }
 }
 
 /// One pose tried by the automatic alignment.
@@ -108,6 +146,7 @@ pub(super) fn coarse_alignment(
             candidates: vec![],
             ambiguous: false,
             warning: None,
+            placed: None,
         });
     }
     if matches!(params.alignment, Alignment::None) {
@@ -120,6 +159,7 @@ pub(super) fn coarse_alignment(
             candidates: vec![],
             ambiguous: false,
             warning: None,
+            placed: None,
         });
     }
     automatic(pos, tris, net, orientation, progress)
@@ -184,6 +224,8 @@ fn automatic(
     let Some((chosen, Some((warped, warp, best, _)))) = tried.first().cloned() else {
         return Err(Error::Internal("automatic alignment found no pose".into()));
     };
+    // (Before the template moves: against where it was given.)
+    let placed = PlacedReport::new(align::placed_rms_relative(pos, &net.points), pos, &chosen.sim);
     // The template's normals through the chosen similarity and its warp.
     let sim = chosen.sim.jacobian();
     orientation.push(pos, |_, p| mat_mul(&warp.map.jacobian(chosen.sim.apply(p)), &sim));
@@ -218,6 +260,7 @@ fn automatic(
         candidates,
         ambiguous,
         warning,
+        placed: Some(placed),
     })
 }
 
@@ -372,6 +415,7 @@ fn pairs_similarity(
         candidates: vec![],
         ambiguous: false,
         warning: None,
+        placed: None,
     })
 }
 

@@ -38,6 +38,9 @@ pub struct Similarity {
 }
 
 impl Similarity {
+    /// The template where it is: x ↦ x.
+    pub const PLACED: Similarity = Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] };
+
     pub fn apply(&self, p: Point3) -> Point3 {
         let r = &self.r;
         let q = [dot(r[0], p), dot(r[1], p), dot(r[2], p)];
@@ -239,8 +242,7 @@ pub fn pca_icp(
     progress: &Progress,
 ) -> Result<(Similarity, f64)> {
     let c = pca_icp_candidates(template, curve, iterations, 3, progress)?;
-    Ok(c.first()
-        .map_or((Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] }, f64::INFINITY), |c| (c.sim, c.icp_rms)))
+    Ok(c.first().map_or((Similarity::PLACED, f64::INFINITY), |c| (c.sim, c.icp_rms)))
 }
 
 /// PCA starts + similarity ICP. Returns up to three *distinct* poses (rotations more than
@@ -304,12 +306,17 @@ pub fn pca_icp_candidates(
     // it. A template placed elsewhere is no start: ICP from there ends wherever the nearest
     // vertices pull it (a sphere at the origin against a thin shape at (0.5, 0.5, 0.5) shrank
     // into a pose no PCA start gives, and the fit then cut 10 of 20 regions).
-    let placed = Similarity { r: IDENTITY, s: 1.0, t: [0.0; 3] };
-    if icp(&coarse_template, &coarse_tree, &few, placed, 0, &[], 0, progress)?.1
-        <= PLACED_NEAR * diagonal(template)
-    {
-        let (m, score) =
-            icp(&coarse_template, &coarse_tree, &few, placed, iterations.min(10), &[], 0, progress)?;
+    if lies_on(&coarse_template, &coarse_tree, &few, diagonal(template)) {
+        let (m, score) = icp(
+            &coarse_template,
+            &coarse_tree,
+            &few,
+            Similarity::PLACED,
+            iterations.min(10),
+            &[],
+            0,
+            progress,
+        )?;
         scored.push((score, m));
     }
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -337,7 +344,34 @@ pub fn pca_icp_candidates(
 
 /// The template as placed is an ICP start when the curve points' RMS distance to its nearest
 /// vertices is at most this fraction of its bounding-box diagonal.
-const PLACED_NEAR: f64 = 0.1;
+pub const PLACED_NEAR: f64 = 0.1;
+
+/// RMS distance of `curve` (a spread subset) to the nearest vertices of `template` (a spread
+/// subset) where the template is placed, over the template's bounding-box diagonal: what the
+/// search compares with [`PLACED_NEAR`].
+pub fn placed_rms_relative(template: &[Point3], curve: &[Point3]) -> f64 {
+    let coarse_template = subsample(template, SCORING_TEMPLATE_POINTS);
+    let tree = KdTree::new(&coarse_template);
+    rms_to_nearest(&coarse_template, &tree, &subsample(curve, 300))
+        / diagonal(template).max(f64::MIN_POSITIVE)
+}
+
+/// The curves already lie on the template as placed ([`PLACED_NEAR`]).
+fn lies_on(template: &[Point3], tree: &KdTree, curve: &[Point3], diag: f64) -> bool {
+    rms_to_nearest(template, tree, curve) <= PLACED_NEAR * diag
+}
+
+/// RMS distance of `curve` to the nearest of `template`'s points (`tree` over them).
+fn rms_to_nearest(template: &[Point3], tree: &KdTree, curve: &[Point3]) -> f64 {
+    let d2: Vec<f64> = curve
+        .iter()
+        .filter_map(|&c| tree.nearest(c).map(|(i, _)| norm2(sub(template[i as usize], c))))
+        .collect();
+    if d2.is_empty() {
+        return f64::INFINITY;
+    }
+    (d2.iter().sum::<f64>() / d2.len() as f64).sqrt()
+}
 
 /// The bounding-box diagonal of `p` (0 when empty).
 fn diagonal(p: &[Point3]) -> f64 {
