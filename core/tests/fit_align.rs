@@ -349,3 +349,29 @@ fn the_report_says_how_far_the_pose_turned_from_the_template_as_given() {
     // The turn is about the box centre, which the template's centre is near: it hardly moves.
     assert!(a["placed"]["moved_relative"].as_f64().expect("moved") < 0.05, "{a}");
 }
+
+/// The same template given elsewhere (turned a quarter about z, moved 2 away from its feature
+/// lines): the placed pose is no start, and no PCA start comes near the pose (the curves' principal
+/// axes are nothing like the part's). The 24 axis assignments in the world frame, bounding boxes
+/// matched, find it. Before them (session 23) a 3,000-vertex coarse copy came out with 1,804 of
+/// 7,090 faces against the part. Truth: the template where the curves are.
+#[test]
+fn a_template_given_elsewhere_finds_its_feature_lines() {
+    let truth = shared("rocker-arm");
+    let curves = feature_curves(&truth, 50.0);
+    let mut template = truth.clone();
+    for p in &mut template.positions {
+        *p = [2.0 - p[1], p[0], p[2]];
+    }
+    let out = run(vec![template, curves], &FitParams::default(), &Progress::new()).expect("fit");
+    let a = &out.report["alignment"];
+    eprintln!("alignment placed {}", a["placed"]);
+    assert_eq!(a["placed"]["on_curves"], false, "{a}");
+    let m = &out.meshes[0];
+    let against = TruthSurface::new(&truth).faces_against(m);
+    let faces = m.faces.len();
+    let far = TruthSurface::new(&truth).max_distance(m);
+    eprintln!("{against} of {faces} faces against the part; farthest vertex {far:.2e}");
+    assert!(against * 200 < faces, "{against} of {faces} output faces face against the part");
+    assert!(far < 5e-3, "an output vertex is {far:.2e} off the part (diagonal ~1.4)");
+}

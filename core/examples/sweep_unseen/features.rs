@@ -37,6 +37,20 @@ pub fn features() -> Vec<Case> {
                 Expect::Fit(regions),
             ));
         }
+        // The template given elsewhere (turned a quarter about z, moved 2 away): the placed pose is
+        // no start, and only the PCA starts are left for curves that sample it unevenly.
+        out.push(case(
+            &format!("coarse {name} (3000 vertices) turned and moved off its feature lines over {deg}°"),
+            move || {
+                let mut t = coarse_copy(name, 3000)?;
+                for p in &mut t.positions {
+                    *p = [2.0 - p[1], p[0], p[2]];
+                }
+                Ok(vec![t, feature_curves(&source(name)?, deg)])
+            },
+            json!({}),
+            Expect::Fit(regions),
+        ));
     }
     out
 }
