@@ -222,6 +222,16 @@ fn a_known_rotation_scale_and_translation_is_recovered() {
     assert_eq!(out.report["segments_as_edges"].as_f64(), Some(1.0));
 }
 
+/// The automatic fit of a flat figure (its curves on one plane: `coplanar_centres = "augment"`),
+/// the alignment printed.
+fn fit_flat(template: Mesh, curves: Mesh) -> meshwork_core::job::Output {
+    let params =
+        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
+    let out = run(vec![template, curves], &params, &Progress::new()).expect("fit");
+    eprintln!("alignment {}", out.report["alignment"]);
+    out
+}
+
 /// Woody is flat and nearly symmetric: placed anywhere but on its curves, turned over it fits its
 /// sections almost as well, and the fit must say so (before: it silently chose the mirror image, 5
 /// of 11 regions). The template is turned a quarter about z and moved off the curves, so the pose
@@ -233,11 +243,8 @@ fn a_flat_nearly_symmetric_figure_is_reported_as_ambiguous() {
     for p in &mut template.positions {
         *p = [3.0 - p[1], p[0], p[2]];
     }
-    let params =
-        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
-    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let out = fit_flat(template, bent_sections(&m));
     let a = &out.report["alignment"];
-    eprintln!("alignment {a}");
     assert_eq!(a["ambiguous"], true, "{a}");
 }
 
@@ -253,11 +260,8 @@ fn a_flat_nearly_symmetric_figure_on_its_curves_keeps_its_pose() {
     for p in &mut truth.positions {
         *p = bend(*p, 1.0);
     }
-    let params =
-        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
-    let out = run(vec![template, bent_sections(&m)], &params, &Progress::new()).expect("fit");
+    let out = fit_flat(template, bent_sections(&m));
     let a = &out.report["alignment"];
-    eprintln!("alignment {a}");
     assert_eq!(a["ambiguous"], false, "{a}");
     let o = &out.meshes[0];
     let against = TruthSurface::new(&truth).faces_against(o);
@@ -274,20 +278,27 @@ fn a_flat_nearly_symmetric_figure_on_its_curves_keeps_its_pose() {
 /// output faces may face against the closest template face.
 #[test]
 fn a_flat_figure_under_its_own_sections_keeps_its_side_up() {
-    use meshwork_core::fit::testdata::TruthSurface;
     use meshwork_core::repair::{self, RepairParams};
     let params = RepairParams { fill_holes: false, ..Default::default() };
     let mut m = repair::run(shared("alligator"), &params, &Progress::new()).expect("repair").meshes.remove(0);
     to_unit_box(&mut m);
     let curves = plane_sections(&m, &sweep_planes(&m));
-    let fit_params =
-        FitParams { coplanar_centres: meshwork_core::fit::CoplanarCentres::Augment, ..Default::default() };
-    let out = run(vec![m.clone(), curves], &fit_params, &Progress::new()).expect("fit");
+    let out = fit_flat(m.clone(), curves);
     let o = &out.meshes[0];
     let tris = o.faces.triangles();
     let against = TruthSurface::new(&m).faces_against(o);
-    eprintln!("{against} of {} faces against the truth; alignment {}", tris.len(), out.report["alignment"]);
+    eprintln!("{against} of {} faces against the truth", tris.len());
     assert!(100 * against <= tris.len(), "{against} of {} faces turned over", tris.len());
+}
+
+/// `out` lies on the part `truth` (rocker-arm, diagonal ~1.4): under 0.5 % of its faces face
+/// against it and no vertex is 5e-3 off it.
+fn assert_on_part(truth: &Mesh, out: &Mesh) {
+    let t = TruthSurface::new(truth);
+    let (against, faces, far) = (t.faces_against(out), out.faces.len(), t.max_distance(out));
+    eprintln!("{against} of {faces} faces against the part; farthest vertex {far:.2e}");
+    assert!(against * 200 < faces, "{against} of {faces} output faces face against the part");
+    assert!(far < 5e-3, "an output vertex is {far:.2e} off the part (diagonal ~1.4)");
 }
 
 /// A template placed where its curves are stays there. The curves are rocker-arm's sharp edges
@@ -306,14 +317,7 @@ fn a_template_placed_on_its_feature_lines_stays_in_place() {
     let r = &out.report;
     eprintln!("alignment {}", r["alignment"]);
     assert_eq!(r["alignment"]["method"], "pca_icp");
-    let truth = TruthSurface::new(&template);
-    let m = &out.meshes[0];
-    let against = truth.faces_against(m);
-    let faces = m.faces.len();
-    let far = truth.max_distance(m);
-    eprintln!("{against} of {faces} faces against the template; farthest vertex {far:.2e}");
-    assert!(against * 200 < faces, "{against} of {faces} output faces face against the template");
-    assert!(far < 5e-3, "an output vertex is {far:.2e} off the template (diagonal ~1.4)");
+    assert_on_part(&template, &out.meshes[0]);
     assert_eq!(r["regions"].as_u64(), Some(regions as u64), "regions vs the sharp edges' count");
 }
 
@@ -367,11 +371,5 @@ fn a_template_given_elsewhere_finds_its_feature_lines() {
     let a = &out.report["alignment"];
     eprintln!("alignment placed {}", a["placed"]);
     assert_eq!(a["placed"]["on_curves"], false, "{a}");
-    let m = &out.meshes[0];
-    let against = TruthSurface::new(&truth).faces_against(m);
-    let faces = m.faces.len();
-    let far = TruthSurface::new(&truth).max_distance(m);
-    eprintln!("{against} of {faces} faces against the part; farthest vertex {far:.2e}");
-    assert!(against * 200 < faces, "{against} of {faces} output faces face against the part");
-    assert!(far < 5e-3, "an output vertex is {far:.2e} off the part (diagonal ~1.4)");
+    assert_on_part(&truth, &out.meshes[0]);
 }

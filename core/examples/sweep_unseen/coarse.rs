@@ -8,17 +8,14 @@ use serde_json::json;
 use meshwork_core::fit::testdata::sections_of_repaired;
 use meshwork_core::mesh::Mesh;
 use meshwork_core::morph::simplify::Hierarchy;
-use meshwork_core::repair::{self, RepairParams};
 use meshwork_core::{Error, Progress};
 
-use crate::support::{case, read_as, shared, to_unit_box, Case, Expect};
+use crate::support::{case, read_as, shared, unit_repaired, Case, Expect};
 
-/// The repaired `name` in the sections' unit-box frame, simplified to `vertices`.
+/// The repaired `name` in the sections' unit-box frame (`support::unit_repaired`), simplified to
+/// `vertices`.
 pub fn coarse_copy(name: &str, vertices: usize) -> Result<Mesh, Error> {
-    let raw = read_as(&shared(name), "x.obj")?;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut fixed = repair::run(raw, &params, &Progress::new())?.meshes.remove(0);
-    to_unit_box(&mut fixed);
+    let fixed = unit_repaired(name)?;
     let mut h = Hierarchy::new(&fixed.positions, &fixed.faces.triangles());
     h.simplify(vertices, true, &Progress::new())?;
     let (map, tris) = h.current();

@@ -4,26 +4,14 @@
 //! plane sections, feature lines end in the open and meet at corners of any valence, and they sample
 //! the surface so unevenly that their principal axes are unlike the template's.
 //!
-//! The hand count of the regions: `testdata::sharp_edges` on the source.
+//! The hand count of the regions: `testdata::sharp_edges` on the source (`support::unit_repaired`,
+//! the frame of `coarse_copy`).
 
 use serde_json::json;
 
-use meshwork_core::fit::testdata::{feature_curves, sharp_edges};
-use meshwork_core::mesh::Mesh;
-use meshwork_core::repair::{self, RepairParams};
-use meshwork_core::{Error, Progress};
-
 use crate::coarse::coarse_copy;
-use crate::support::{case, read_as, shared, to_unit_box, Case, Expect};
-
-/// The repaired `name` in the unit box (the frame of `coarse_copy`).
-fn source(name: &str) -> Result<Mesh, Error> {
-    let raw = read_as(&shared(name), "x.obj")?;
-    let params = RepairParams { fill_holes: false, ..Default::default() };
-    let mut fixed = repair::run(raw, &params, &Progress::new())?.meshes.remove(0);
-    to_unit_box(&mut fixed);
-    Ok(fixed)
-}
+use crate::support::{case, unit_repaired as source, Case, Expect};
+use meshwork_core::fit::testdata::{feature_curves, sharp_edges};
 
 pub fn features() -> Vec<Case> {
     let mut out = Vec::new();

@@ -63,8 +63,9 @@ pub struct PlacedReport {
 
 impl PlacedReport {
     fn new(rms_relative: f64, template: &[Point3], chosen: &align::Similarity) -> PlacedReport {
-        let diag = Aabb::of(template).map_or(0.0, |b| b.diagonal()).max(f64::MIN_POSITIVE);
-        let centre = Aabb::of(template).map_or([0.0; 3], |b| b.center());
+        let bb = Aabb::of(template);
+        let diag = bb.map_or(0.0, |b| b.diagonal()).max(f64::MIN_POSITIVE);
+        let centre = bb.map_or([0.0; 3], |b| b.center());
         PlacedReport {
             rms_relative,
             on_curves: rms_relative <= align::PLACED_NEAR,
@@ -199,7 +200,8 @@ fn automatic(
     let planar = rbf::spread_ratios(&net.points)[0] < PLANAR_CURVES;
     let ends =
         align::RimEnds { edges: &rim.edges, ends: if planar { &rim.ends } else { &no_ends }, cap: rim.cap };
-    let candidates = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
+    let search = align::pca_icp_candidates(pos, &net.points, 30, 3, progress)?;
+    let candidates = search.candidates;
     let mut tried: Vec<(align::Candidate, Option<(Vec<Point3>, align::WarpReport, f64, Option<f64>)>)> =
         Vec::new();
     // The contenders' scores with the warp of the curve points alone, when the rim term changes
@@ -225,7 +227,7 @@ fn automatic(
         return Err(Error::Internal("automatic alignment found no pose".into()));
     };
     // (Before the template moves: against where it was given.)
-    let placed = PlacedReport::new(align::placed_rms_relative(pos, &net.points), pos, &chosen.sim);
+    let placed = PlacedReport::new(search.placed_rms_relative, pos, &chosen.sim);
     // The template's normals through the chosen similarity and its warp.
     let sim = chosen.sim.jacobian();
     orientation.push(pos, |_, p| mat_mul(&warp.map.jacobian(chosen.sim.apply(p)), &sim));

@@ -12,7 +12,7 @@ use super::coarse::{fit_rbf, CoarseReport};
 use super::insert::coincident;
 use super::orientation::Orientation;
 use super::rbf::{Gradient, Rbf};
-use super::{approach, correspond, curves, flips, insert, FitParams, Matching};
+use super::{approach, correspond, curves, flips, insert, refine, FitParams, Matching};
 
 /// The fine stage's result.
 pub struct Fine {
@@ -401,4 +401,54 @@ fn fine_fit(
         return Ok((fine, f));
     }
     Err(Error::Internal("flip loop ended without a result".into()))
+}
+
+/// Stage 3: the approach levels, the refinement under dense curves, then the fine RBF by the
+/// matching rule ([`fine_dispatch`]). `parents` gets the weighted parents of every vertex added.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fine_stage(
+    pos: &mut Vec<Point3>,
+    tris: &mut Vec<[u32; 3]>,
+    parents: &mut Vec<[(u32, f64); 3]>,
+    orientation: &mut Orientation,
+    net: &curves::CurveNetwork,
+    coarse: &CoarseReport,
+    params: &FitParams,
+    reach: Reach,
+    progress: &Progress,
+) -> Result<(Fine, refine::RefineReport)> {
+    let clock = std::time::Instant::now();
+    let pair_fixed = coarse.pair_fixed(&params.pairs);
+    let levels = params.approach_levels as usize;
+    let limit = reach.limit();
+    let approach = approach::approach(
+        pos,
+        tris,
+        parents,
+        net,
+        &pair_fixed,
+        params.kernel,
+        levels,
+        limit,
+        params.thin_rim_feet,
+        orientation,
+        progress,
+    )?;
+    let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
+    // Faces of the approached template under dense curves are split, so no face has to hold
+    // many curve vertices (after the approach: feet of curves still far from a coarse surface
+    // cluster where it is closest, which is no density of the curves).
+    let budget = tris.len() + super::REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
+    let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
+    // One closest-point search (a BVH over the approached template) for the refinement's
+    // density check and the insertion's feet; the refinement replaces it when it splits.
+    let mut search = insert::FootSearch::new_polled(pos, tris, progress)?;
+    let mut refined =
+        refine::refine_near_curves(pos, tris, net, &mut search, dense, max, budget, parents, progress)?;
+    refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
+    let mut fine =
+        fine_dispatch(pos, tris, net, coarse, params, reach, parents, search, orientation, progress)?;
+    fine.report.approach = Some(approach);
+    fine.report.approach_ms = approach_ms;
+    Ok((fine, refined))
 }

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use crate::error::Result;
 use crate::job::Progress;
-use crate::mesh::{Mesh, Point3};
+use crate::mesh::{Faces, Mesh, Point3};
 
 use super::insert::barycentric;
 
@@ -158,4 +158,37 @@ pub fn after_retriangulation(
             count.into_iter().max_by_key(|&(g, c)| (c, std::cmp::Reverse(g))).map_or(0, |x| x.0)
         })
         .collect()
+}
+
+/// The output's faces in group order (stable: an OBJ gets one `g` block per group, not one per
+/// change), their groups and the group names: one group per region, or per region × template
+/// group when `template_groups` (each face's group, and the template naming them) is given.
+pub fn grouped_faces(
+    tris: Vec<[u32; 3]>,
+    region: &[u32],
+    region_count: usize,
+    template_groups: Option<(&[u32], &Mesh)>,
+) -> (Vec<[u32; 3]>, Faces, Vec<String>) {
+    let tg = |i: usize| template_groups.map_or(0, |(g, _)| g[i]);
+    let mut order: Vec<usize> = (0..tris.len()).collect();
+    order.sort_by_key(|&i| (region[i], tg(i)));
+    let sorted: Vec<[u32; 3]> = order.iter().map(|&i| tris[i]).collect();
+    let mut faces = Faces::with_capacity(sorted.len(), sorted.len() * 3);
+    let Some((_, template)) = template_groups else {
+        for (t, &i) in sorted.iter().zip(&order) {
+            faces.push(t, region[i]);
+        }
+        return (sorted, faces, (0..region_count).map(|i| format!("region_{i}")).collect());
+    };
+    let mut names = Vec::new();
+    let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for (t, &i) in sorted.iter().zip(&order) {
+        let (r, g) = (region[i], tg(i));
+        let gid = *id.entry((r, g)).or_insert_with(|| {
+            names.push(format!("region_{r}/{}", template.group_name(g)));
+            (names.len() - 1) as u32
+        });
+        faces.push(t, gid);
+    }
+    (sorted, faces, names)
 }

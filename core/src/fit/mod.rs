@@ -17,7 +17,8 @@
 //! The output mesh has one face group per region and carries the curves as vertex chains.
 //!
 //! Files: `params.rs` (the job's parameters), `coarse.rs` (stage 2 and the RBF fit with its named
-//! errors), `fine.rs` (stage 3 by matching rule), this file (the pipeline, [`run`]).
+//! errors), `fine.rs` (stage 3: `fine_stage`, by matching rule), `groups.rs` (region and template
+//! group labels, the output's face groups), this file (the pipeline, [`run`]).
 
 pub mod align;
 pub mod approach;
@@ -55,7 +56,7 @@ pub mod uvs;
 use crate::error::{Error, Result};
 use crate::geometry::{add, dist, scale, Aabb};
 use crate::job::{Output, Progress, Stages};
-use crate::mesh::{Faces, Mesh, Point3};
+use crate::mesh::{Mesh, Point3};
 
 pub use coarse::CoarseReport;
 pub use fine::{interpolate_uvs, Fine, FineReport};
@@ -63,7 +64,6 @@ pub use params::{Alignment, CoplanarCentres, FitPair, FitParams, Matching};
 pub use rbf::Kernel;
 
 use coarse::coarse_alignment;
-use fine::fine_dispatch;
 
 /// The refinement's face budget: this many faces per curve vertex, over the template's.
 const REFINE_FACES_PER_CURVE_VERTEX: usize = 8;
@@ -155,7 +155,7 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     // `template.vertex_count() + i` has `parents[i]`): the template's UVs follow them.
     let mut parents: Vec<[(u32, f64); 3]> = Vec::new();
     let (fine, refined) = stages.run(progress, "fine", || {
-        fine_stage(
+        fine::fine_stage(
             &mut pos,
             &mut tris,
             &mut parents,
@@ -448,8 +448,12 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
 
     // Output mesh: one group per region (per region × template group when the template had
     // groups), the curves as vertex chains.
-    let (out_tris, faces, group_names) =
-        grouped_faces(out_tris, &region, region_count, keep_groups.then_some((tg.as_slice(), &template)));
+    let (out_tris, faces, group_names) = groups::grouped_faces(
+        out_tris,
+        &region,
+        region_count,
+        keep_groups.then_some((tg.as_slice(), &template)),
+    );
     let mut out = Mesh::new(out_pos, faces);
     out.uvs = template.uvs.as_ref().map(|uv| {
         // In the order the vertices were made and moved: fine-stage splits, fine untangling,
@@ -569,56 +573,6 @@ pub fn run(inputs: Vec<Mesh>, params: &FitParams, progress: &Progress) -> Result
     Ok(Output { meshes: vec![out], report, ..Default::default() })
 }
 
-/// Stage 3: the approach levels, the refinement under dense curves, then the fine RBF by the
-/// matching rule ([`fine_dispatch`]). `parents` gets the weighted parents of every vertex added.
-#[allow(clippy::too_many_arguments)]
-fn fine_stage(
-    pos: &mut Vec<Point3>,
-    tris: &mut Vec<[u32; 3]>,
-    parents: &mut Vec<[(u32, f64); 3]>,
-    orientation: &mut orientation::Orientation,
-    net: &curves::CurveNetwork,
-    coarse: &CoarseReport,
-    params: &FitParams,
-    reach: fine::Reach,
-    progress: &Progress,
-) -> Result<(Fine, refine::RefineReport)> {
-    let clock = std::time::Instant::now();
-    let pair_fixed = coarse.pair_fixed(&params.pairs);
-    let levels = params.approach_levels as usize;
-    let limit = reach.limit();
-    let approach = approach::approach(
-        pos,
-        tris,
-        parents,
-        net,
-        &pair_fixed,
-        params.kernel,
-        levels,
-        limit,
-        params.thin_rim_feet,
-        orientation,
-        progress,
-    )?;
-    let approach_ms = clock.elapsed().as_secs_f64() * 1e3;
-    // Faces of the approached template under dense curves are split, so no face has to hold
-    // many curve vertices (after the approach: feet of curves still far from a coarse surface
-    // cluster where it is closest, which is no density of the curves).
-    let budget = tris.len() + REFINE_FACES_PER_CURVE_VERTEX * net.points.len();
-    let (dense, max) = (params.refine_dense_feet, params.refine_max_feet);
-    // One closest-point search (a BVH over the approached template) for the refinement's
-    // density check and the insertion's feet; the refinement replaces it when it splits.
-    let mut search = insert::FootSearch::new_polled(pos, tris, progress)?;
-    let mut refined =
-        refine::refine_near_curves(pos, tris, net, &mut search, dense, max, budget, parents, progress)?;
-    refined.ms = clock.elapsed().as_secs_f64() * 1e3 - approach_ms;
-    let mut fine =
-        fine_dispatch(pos, tris, net, coarse, params, reach, parents, search, orientation, progress)?;
-    fine.report.approach = Some(approach);
-    fine.report.approach_ms = approach_ms;
-    Ok((fine, refined))
-}
-
 /// The template's triangles (`tris`, fanned from its faces), checked: some faces, an oriented
 /// manifold (the error names the template's face, not the fanned triangle).
 fn validated(template: &Mesh, tris: &[[u32; 3]]) -> Result<Vec<[u32; 3]>> {
@@ -630,39 +584,6 @@ fn validated(template: &Mesh, tris: &[[u32; 3]]) -> Result<Vec<[u32; 3]>> {
         .collect();
     trimesh::check_oriented_manifold_faces(tris, Some(&face_of))?;
     Ok(tris.to_vec())
-}
-
-/// The output's faces in group order (stable: an OBJ gets one `g` block per group, not one per
-/// change), their groups and the group names: one group per region, or per region × template
-/// group when `template_groups` (each face's group, and the template naming them) is given.
-fn grouped_faces(
-    tris: Vec<[u32; 3]>,
-    region: &[u32],
-    region_count: usize,
-    template_groups: Option<(&[u32], &Mesh)>,
-) -> (Vec<[u32; 3]>, Faces, Vec<String>) {
-    let tg = |i: usize| template_groups.map_or(0, |(g, _)| g[i]);
-    let mut order: Vec<usize> = (0..tris.len()).collect();
-    order.sort_by_key(|&i| (region[i], tg(i)));
-    let sorted: Vec<[u32; 3]> = order.iter().map(|&i| tris[i]).collect();
-    let mut faces = Faces::with_capacity(sorted.len(), sorted.len() * 3);
-    let Some((_, template)) = template_groups else {
-        for (t, &i) in sorted.iter().zip(&order) {
-            faces.push(t, region[i]);
-        }
-        return (sorted, faces, (0..region_count).map(|i| format!("region_{i}")).collect());
-    };
-    let mut names = Vec::new();
-    let mut id: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for (t, &i) in sorted.iter().zip(&order) {
-        let (r, g) = (region[i], tg(i));
-        let gid = *id.entry((r, g)).or_insert_with(|| {
-            names.push(format!("region_{r}/{}", template.group_name(g)));
-            (names.len() - 1) as u32
-        });
-        faces.push(t, gid);
-    }
-    (sorted, faces, names)
 }
 
 /// The chain edges of `chains`, each as (smaller, larger) vertex.

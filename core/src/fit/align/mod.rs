@@ -241,8 +241,18 @@ pub fn pca_icp(
     iterations: u32,
     progress: &Progress,
 ) -> Result<(Similarity, f64)> {
-    let c = pca_icp_candidates(template, curve, iterations, 3, progress)?;
+    let c = pca_icp_candidates(template, curve, iterations, 3, progress)?.candidates;
     Ok(c.first().map_or((Similarity::PLACED, f64::INFINITY), |c| (c.sim, c.icp_rms)))
+}
+
+/// What [`pca_icp_candidates`] found.
+pub struct Search {
+    /// The distinct poses (rotations more than [`SAME_POSE_DEG`] apart), contenders first, best
+    /// ICP score first.
+    pub candidates: Vec<Candidate>,
+    /// RMS distance of the curve points to the template's nearest vertices as placed, over its
+    /// bounding-box diagonal (compared with [`PLACED_NEAR`]).
+    pub placed_rms_relative: f64,
 }
 
 /// PCA starts + similarity ICP. Returns up to three *distinct* poses (rotations more than
@@ -264,7 +274,7 @@ pub fn pca_icp_candidates(
     iterations: u32,
     keep: usize,
     progress: &Progress,
-) -> Result<Vec<Candidate>> {
+) -> Result<Search> {
     let (at, st) = pca(template);
     let (ac, sc) = pca(curve);
     let (mt, mc) = (mean(template), mean(curve));
@@ -290,17 +300,10 @@ pub fn pca_icp_candidates(
     // it. A template placed elsewhere is no start: ICP from there ends wherever the nearest
     // vertices pull it (a sphere at the origin against a thin shape at (0.5, 0.5, 0.5) shrank
     // into a pose no PCA start gives, and the fit then cut 10 of 20 regions).
-    if lies_on(&coarse_template, &coarse_tree, &few, diagonal(template)) {
-        let (m, score) = icp(
-            &coarse_template,
-            &coarse_tree,
-            &few,
-            Similarity::PLACED,
-            iterations.min(10),
-            &[],
-            0,
-            progress,
-        )?;
+    let diag = Aabb::of(template).map_or(0.0, |b| b.diagonal()).max(f64::MIN_POSITIVE);
+    let placed_rms_relative = rms_to_nearest(&coarse_template, &coarse_tree, &few) / diag;
+    if placed_rms_relative <= PLACED_NEAR {
+        let (m, score) = short_icp(Similarity::PLACED)?;
         scored.push((score, m));
     }
     // The same 24 axis assignments in the world frame, bounding boxes matched (centre and
@@ -311,11 +314,12 @@ pub fn pca_icp_candidates(
     // ([`WORLD_START_GAIN`]): where the PCA starts work, their poses are the candidates, as before
     // (kept whenever they were new, a flat figure's turned-over pose entered and won: alligator
     // twisted, 6,628 faces against the truth).
-    if let (Some(bt), Some(bc)) = (Aabb::of(template), Aabb::of(curve)) {
-        let s = bc.diagonal() / bt.diagonal().max(f64::MIN_POSITIVE);
-        let (ct, cc) = (bt.center(), bc.center());
+    let boxes = Aabb::of(template).zip(Aabb::of(curve));
+    let box_scale = boxes.map_or(0.0, |(bt, bc)| bc.diagonal() / bt.diagonal().max(f64::MIN_POSITIVE));
+    if let Some((bt, bc)) = boxes.filter(|_| box_scale.is_finite() && box_scale > 0.0) {
+        let (s, ct, cc) = (box_scale, bt.center(), bc.center());
         let mut world: Vec<(f64, Similarity)> = Vec::new();
-        for r in axis_assignments(&IDENTITY, &IDENTITY).into_iter().filter(|_| s.is_finite() && s > 0.0) {
+        for r in axis_assignments(&IDENTITY, &IDENTITY) {
             let rc = [dot(r[0], ct), dot(r[1], ct), dot(r[2], ct)];
             let (m, score) = short_icp(Similarity { r, s, t: sub(cc, scale(rc, s)) })?;
             world.push((score, m));
@@ -345,14 +349,14 @@ pub fn pca_icp_candidates(
         }
     }
     refined.sort_by(|a, b| b.contender.cmp(&a.contender).then(a.icp_rms.total_cmp(&b.icp_rms)));
-    Ok(distinct(refined.into_iter(), usize::MAX))
+    Ok(Search { candidates: distinct(refined.into_iter(), usize::MAX), placed_rms_relative })
 }
 
 /// A world-frame start's pose enters the search only when its short-ICP score is below this
-/// fraction of the best of the PCA starts' and the placed start's (woody on its curves: the
-/// turned-over world pose, 2 % behind the placed one, made the choice ambiguous without the placed
-/// start in the comparison) (rocker-arm under its own feature lines, moved off them:
-/// 0.0065 against 0.020).
+/// fraction of the best of the PCA starts' and the placed start's. Rocker-arm moved off its own
+/// feature lines: 0.0065 against 0.020. The placed start is in the comparison because, without
+/// it, woody on its curves got the world frame's turned-over pose 2 % behind the placed one, and
+/// the choice became ambiguous.
 const WORLD_START_GAIN: f64 = 0.8;
 
 /// The 24 proper rotations taking the columns of `from` (an orthonormal frame, e.g. the template's
@@ -385,21 +389,6 @@ fn axis_assignments(to: &[[f64; 3]; 3], from: &[[f64; 3]; 3]) -> Vec<[[f64; 3]; 
 /// vertices is at most this fraction of its bounding-box diagonal.
 pub const PLACED_NEAR: f64 = 0.1;
 
-/// RMS distance of `curve` (a spread subset) to the nearest vertices of `template` (a spread
-/// subset) where the template is placed, over the template's bounding-box diagonal: what the
-/// search compares with [`PLACED_NEAR`].
-pub fn placed_rms_relative(template: &[Point3], curve: &[Point3]) -> f64 {
-    let coarse_template = subsample(template, SCORING_TEMPLATE_POINTS);
-    let tree = KdTree::new(&coarse_template);
-    rms_to_nearest(&coarse_template, &tree, &subsample(curve, 300))
-        / diagonal(template).max(f64::MIN_POSITIVE)
-}
-
-/// The curves already lie on the template as placed ([`PLACED_NEAR`]).
-fn lies_on(template: &[Point3], tree: &KdTree, curve: &[Point3], diag: f64) -> bool {
-    rms_to_nearest(template, tree, curve) <= PLACED_NEAR * diag
-}
-
 /// RMS distance of `curve` to the nearest of `template`'s points (`tree` over them).
 fn rms_to_nearest(template: &[Point3], tree: &KdTree, curve: &[Point3]) -> f64 {
     let d2: Vec<f64> = curve
@@ -410,11 +399,6 @@ fn rms_to_nearest(template: &[Point3], tree: &KdTree, curve: &[Point3]) -> f64 {
         return f64::INFINITY;
     }
     (d2.iter().sum::<f64>() / d2.len() as f64).sqrt()
-}
-
-/// The bounding-box diagonal of `p` (0 when empty).
-fn diagonal(p: &[Point3]) -> f64 {
-    Aabb::of(p).map_or(0.0, |b| b.diagonal())
 }
 
 /// Poses whose ICP score (against the template subset) is within this factor of the best are

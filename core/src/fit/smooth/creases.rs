@@ -7,36 +7,56 @@ use crate::geometry::{dot, norm2, triangle_cross};
 use crate::mesh::Point3;
 use crate::topology::Csr;
 
-/// The vertices of a crease: an edge of exactly two faces whose normals differ by more than `deg`
-/// degrees (a boundary or non-manifold edge is no crease; a zero-area face counts as
-/// perpendicular to its neighbour). The
-/// faces on an edge come from the vertex → faces lists, as in [`fold_stats`], each edge judged once
-/// from its first face.
+/// An edge of exactly two faces `f` < `g` (in index order), with the cosine of the angle between
+/// their normals (0 when one has zero area: it counts as perpendicular).
+#[derive(Debug, Clone, Copy)]
+pub struct EdgeBend {
+    pub a: u32,
+    pub b: u32,
+    pub f: u32,
+    pub g: u32,
+    pub cos: f64,
+}
+
+/// Every edge of exactly two faces, once (a boundary or non-manifold edge is left out), with its
+/// bend. The faces on an edge come from the vertex → faces lists, as in [`fold_stats`], each edge
+/// judged once from its first face.
 ///
 /// [`fold_stats`]: super::super::untangle::fold_stats
-pub fn crease_vertices(pos: &[Point3], tris: &[[u32; 3]], deg: f64) -> Vec<bool> {
+pub fn edge_bends(pos: &[Point3], tris: &[[u32; 3]]) -> Vec<EdgeBend> {
     let normals: Vec<Point3> = tris
         .par_iter()
         .map(|t| triangle_cross(pos[t[0] as usize], pos[t[1] as usize], pos[t[2] as usize]))
         .collect();
     let vertex_faces = Csr::vertex_triangles(pos.len(), tris);
-    let cos = deg.to_radians().cos();
-    let mut on = vec![false; pos.len()];
+    let mut out = Vec::new();
     for (f, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             let mut on_edge = vertex_faces.triangles_on_edge(tris, a, b);
-            let (Some(g), Some(h), None) = (on_edge.next(), on_edge.next(), on_edge.next()) else { continue };
-            if g as usize != f {
+            let (Some(f0), Some(g), None) = (on_edge.next(), on_edge.next(), on_edge.next()) else {
+                continue;
+            };
+            if f0 as usize != f {
                 continue;
             }
-            let (n, m) = (normals[g as usize], normals[h as usize]);
+            let (n, m) = (normals[f0 as usize], normals[g as usize]);
             let d = (norm2(n) * norm2(m)).sqrt();
-            if (if d > 0.0 { dot(n, m) / d } else { 0.0 }) < cos {
-                on[a as usize] = true;
-                on[b as usize] = true;
-            }
+            let cos = if d > 0.0 { dot(n, m) / d } else { 0.0 };
+            out.push(EdgeBend { a, b, f: f0, g, cos });
         }
+    }
+    out
+}
+
+/// The vertices of a crease: an edge of exactly two faces whose normals differ by more than `deg`
+/// degrees ([`edge_bends`]).
+pub fn crease_vertices(pos: &[Point3], tris: &[[u32; 3]], deg: f64) -> Vec<bool> {
+    let cos = deg.to_radians().cos();
+    let mut on = vec![false; pos.len()];
+    for e in edge_bends(pos, tris).into_iter().filter(|e| e.cos < cos) {
+        on[e.a as usize] = true;
+        on[e.b as usize] = true;
     }
     on
 }

@@ -34,7 +34,7 @@ use super::reference::Reference;
 mod creases;
 mod guard;
 
-pub use creases::{crease_vertices, hold_template_creases};
+pub use creases::{crease_vertices, edge_bends, hold_template_creases, EdgeBend};
 use guard::{face_shape, Guard};
 
 pub struct SmoothSettings {

@@ -4,45 +4,30 @@
 //! that fades out) and meet at corners of any valence. The truth they come with: the regions they
 //! cut the mesh into, counted on the mesh's own faces (joined across every edge that is not sharp).
 
-use std::collections::HashMap;
-
-use crate::geometry::{dot, normalize, triangle_cross};
+use crate::fit::smooth::edge_bends;
 use crate::mesh::{Mesh, Point3};
+use crate::topology::{find, union};
 
 use super::curves::polylines;
 
-/// The interior edges of `m` whose two faces' normals are more than `deg` degrees apart (in a
-/// fixed order), and the number of regions they cut `m` into.
+/// The interior edges of `m` whose two faces' normals are more than `deg` degrees apart, each as
+/// (smaller, larger) vertex in sorted order, and the number of regions they cut `m` into (faces
+/// joined across every other edge of two faces; [`edge_bends`], as smoothing's crease test).
 pub fn sharp_edges(m: &Mesh, deg: f64) -> (Vec<[u32; 2]>, usize) {
     let tris = m.faces.triangles();
-    let normals: Vec<Point3> = tris
-        .iter()
-        .map(|t| {
-            let p = t.map(|v| m.positions[v as usize]);
-            normalize(triangle_cross(p[0], p[1], p[2]))
-        })
-        .collect();
-    let mut by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (f, t) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
-        }
-    }
-    let mut keys: Vec<(u32, u32)> = by_edge.keys().copied().collect();
-    keys.sort_unstable();
     let cos = deg.to_radians().cos();
-    let mut regions = Regions::new(tris.len());
+    let mut parent: Vec<u32> = (0..tris.len() as u32).collect();
     let mut sharp = Vec::new();
-    for e in keys {
-        let &[f, g] = by_edge[&e].as_slice() else { continue };
-        if dot(normals[f], normals[g]) < cos {
-            sharp.push([e.0, e.1]);
+    for e in edge_bends(&m.positions, &tris) {
+        if e.cos < cos {
+            sharp.push([e.a.min(e.b), e.a.max(e.b)]);
         } else {
-            regions.join(f, g);
+            union(&mut parent, e.f, e.g);
         }
     }
-    (sharp, regions.count())
+    sharp.sort_unstable();
+    let regions = (0..tris.len() as u32).filter(|&f| find(&mut parent, f) == f).count();
+    (sharp, regions)
 }
 
 /// The sharp edges of `m` ([`sharp_edges`]) as two-point polylines.
@@ -51,29 +36,6 @@ pub fn feature_curves(m: &Mesh, deg: f64) -> Mesh {
     let lines: Vec<Vec<Point3>> =
         edges.iter().map(|e| vec![m.positions[e[0] as usize], m.positions[e[1] as usize]]).collect();
     polylines(&lines)
-}
-
-/// Union-find over faces.
-struct Regions(Vec<usize>);
-
-impl Regions {
-    fn new(n: usize) -> Regions {
-        Regions((0..n).collect())
-    }
-    fn root(&mut self, mut a: usize) -> usize {
-        while self.0[a] != a {
-            self.0[a] = self.0[self.0[a]];
-            a = self.0[a];
-        }
-        a
-    }
-    fn join(&mut self, a: usize, b: usize) {
-        let (a, b) = (self.root(a), self.root(b));
-        self.0[a] = b;
-    }
-    fn count(&mut self) -> usize {
-        (0..self.0.len()).filter(|&f| self.root(f) == f).count()
-    }
 }
 
 #[cfg(test)]
