@@ -25,7 +25,7 @@ use crate::geometry::{norm2, sub, triangle_cross};
 use crate::job::Progress;
 
 use super::super::trimesh::TriMesh;
-use super::{Ctx, MIN_COS};
+use super::{planar, Ctx, MIN_COS};
 
 /// Longest flip sequence searched per neighbourhood (3: the collinear overlap needs 2).
 const MAX_DEPTH: usize = 3;
@@ -41,17 +41,32 @@ const DEGENERATE: f64 = 1e-12;
 /// the state's faces (the last repair's rules: [`crate::fit::turned`]); none: the badness alone.
 pub(crate) type Guard<'a> = Option<&'a GuardFn<'a>>;
 
-/// The rule of a [`Guard`]: (mesh, original face ids, the state's faces) → keep.
-pub(crate) type GuardFn<'a> = dyn Fn(&TriMesh, &[u32], &[[u32; 3]]) -> bool + 'a;
+/// The rule of a [`Guard`]: (mesh, original face ids, the state's faces, whether the state is a
+/// planar re-triangulation rather than a flip sequence) → keep.
+pub(crate) type GuardFn<'a> = dyn Fn(&TriMesh, &[u32], &[[u32; 3]], bool) -> bool + 'a;
 
 /// What the flip-sequence pass did.
 #[derive(Debug, Default, Clone, Copy)]
-pub(super) struct SearchPass {
-    /// Neighbourhoods replaced.
+pub(crate) struct SearchPass {
+    /// Neighbourhoods replaced by a flip sequence.
     pub regions: usize,
     /// Flips in the sequences applied.
     pub flips: usize,
+    /// Neighbourhoods replaced by a planar re-triangulation ([`super::planar`]).
+    pub planar: usize,
 }
+
+/// How a neighbourhood was replaced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Replaced {
+    /// By a sequence of this many flips.
+    Flips(usize),
+    /// By a new triangulation of its vertices in its plane.
+    Planar,
+}
+
+/// The depth that marks a planar re-triangulation among the search's end states.
+const PLANAR_DEPTH: usize = usize::MAX;
 
 /// Cosine of face `t`'s normal with its reference (0 for a zero-area face): folded at or below
 /// [`MIN_COS`].
@@ -167,7 +182,9 @@ impl Search<'_> {
         let (turned, folded, e) = patch.badness();
         let (bt, bf, be) = self.best.0;
         let better = (turned, folded) < (bt, bf) || ((turned, folded) == (bt, bf) && e < be - 1e-12);
-        if better && self.guard.is_none_or(|g| depth == 0 || g(self.mesh, &patch.original, &patch.faces)) {
+        if better
+            && self.guard.is_none_or(|g| depth == 0 || g(self.mesh, &patch.original, &patch.faces, false))
+        {
             self.best = ((turned, folded, e), patch.faces.clone(), depth);
         }
         if depth == max_depth || self.best.0 .1 == 0 || self.states >= MAX_STATES {
@@ -198,8 +215,13 @@ impl Search<'_> {
 }
 
 /// Replaces the neighbourhood of folded face `f` by the best flip sequence's faces when that has
-/// fewer folded faces; returns the number of flips applied, or the neighbourhood searched in vain.
-fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, guard: Guard, f: u32) -> std::result::Result<usize, Vec<u32>> {
+/// fewer folded faces; returns how it was replaced, or the neighbourhood searched in vain.
+fn repair_one(
+    mesh: &mut TriMesh,
+    ctx: &Ctx,
+    guard: Guard,
+    f: u32,
+) -> std::result::Result<Replaced, Vec<u32>> {
     let original = neighbourhood(mesh, ctx, f);
     let faces: Vec<[u32; 3]> = original.iter().map(|&g| mesh.tris[g as usize]).collect();
     let quality_of: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
@@ -211,6 +233,24 @@ fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, guard: Guard, f: u32) -> std::resul
         search.visit(&mut patch, 0, max_depth, (u32::MAX, u32::MAX));
         if search.best.0 .1 == 0 || search.states >= MAX_STATES {
             break;
+        }
+    }
+    // The last repair only (a guard): where no sequence leaves the neighbourhood free of turned
+    // faces, a new triangulation of its vertices in its plane. Not in the untangling stages
+    // before it (no guard): there the moves and splits that follow do better on what it would
+    // take (session 24: cow twisted (auto) 35 -> 40 flips with it there too).
+    if search.best.0 .0 > 0 {
+        if let Some(g) = guard {
+            if let Some(faces) = planar::retriangulate(mesh, ctx, &patch.faces) {
+                let quality: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
+                let flat = Patch { original: patch.original.clone(), faces, quality };
+                let b = flat.badness();
+                let (bt, bf, be) = search.best.0;
+                let better = (b.0, b.1) < (bt, bf) || ((b.0, b.1) == (bt, bf) && b.2 < be - 1e-12);
+                if better && g(mesh, &flat.original, &flat.faces, true) {
+                    search.best = (b, flat.faces, PLANAR_DEPTH);
+                }
+            }
         }
     }
     // Kept only with fewer faces turned over (or as many and fewer folded): a trade of two faces
@@ -238,7 +278,7 @@ fn repair_one(mesh: &mut TriMesh, ctx: &Ctx, guard: Guard, f: u32) -> std::resul
             }
         }
     }
-    Ok(depth)
+    Ok(if depth == PLANAR_DEPTH { Replaced::Planar } else { Replaced::Flips(depth) })
 }
 
 /// One pass over the folded faces `bad` (in id order): each one still folded gets its
@@ -260,10 +300,11 @@ pub(super) fn flip_sequences(
             continue;
         }
         match repair_one(mesh, ctx, guard, f) {
-            Ok(flips) => {
+            Ok(Replaced::Flips(flips)) => {
                 out.regions += 1;
                 out.flips += flips;
             }
+            Ok(Replaced::Planar) => out.planar += 1,
             Err(faces) => searched.extend(faces),
         }
     }
@@ -322,6 +363,43 @@ pub(crate) mod tests {
             [m, a, c0],
         ];
         (pos, tris)
+    }
+
+    /// A 4 × 4 vertex grid of unit squares (vertex (i, j) is 4j + i, squares split along their
+    /// rising diagonal) with the positions of inner vertices 5 = (1,1) and 10 = (2,2) swapped,
+    /// every vertex fixed: the faces around both are turned over. With a guard (the last repair)
+    /// a neighbourhood no sequence of up to 3 flips leaves unturned is triangulated anew in its
+    /// plane; without one (the untangling stages) it is not.
+    #[test]
+    fn a_swap_no_short_sequence_undoes_is_retriangulated_only_under_a_guard() {
+        let (mut pos, tris) = super::super::planar::tests::grid();
+        pos.swap(5, 10);
+        let reference = vec![[0.0, 0.0, 1.0]; 16];
+        let fixed = [true; 16];
+        let locked = EdgeSet::default();
+        let ctx = Ctx { reference: &reference, fixed: &fixed, locked: &locked };
+        let progress = crate::job::Progress::new();
+        let run = |guard: Guard| {
+            let mut mesh = TriMesh::new(pos.clone(), tris.clone()).unwrap();
+            let bad: Vec<u32> = (0..18).filter(|&f| ctx.folded(&mesh, f)).collect();
+            assert!(!bad.is_empty());
+            let pass = flip_sequences(&mut mesh, &ctx, guard, &bad, &progress).unwrap();
+            (pass, mesh)
+        };
+        let (pass, mesh) = run(None);
+        assert_eq!(pass.planar, 0);
+        assert!(!faces_not_up(&mesh).is_empty(), "3 flips do not undo the swap: {pass:?}");
+        let accept = |_: &TriMesh, _: &[u32], _: &[[u32; 3]], _: bool| true;
+        let (pass, mesh) = run(Some(&accept));
+        assert!(pass.planar >= 1, "{pass:?}");
+        assert_eq!(faces_not_up(&mesh), Vec::<[u32; 3]>::new());
+        assert_eq!(mesh.live_faces(), 18);
+        assert_eq!(mesh.pos, pos, "a fixed vertex moved");
+        // A guard that refuses everything keeps the mesh as it was.
+        let refuse = |_: &TriMesh, _: &[u32], _: &[[u32; 3]], _: bool| false;
+        let (pass, mesh) = run(Some(&refuse));
+        assert_eq!((pass.regions, pass.planar), (0, 0));
+        assert_eq!(mesh.live_triangles(), tris);
     }
 
     #[test]

@@ -29,6 +29,7 @@ pub(crate) mod flip_search;
 mod folds;
 mod kernel;
 mod patch;
+mod planar;
 mod steep;
 
 pub use folds::{fold_stats, folded_pair, FoldStats, FOLD_ANGLE_DEG};
@@ -191,7 +192,7 @@ pub fn untangle_polled(
 
 /// One pass of flip sequences ([`flip_search`]) over the faces `bad` that are turned against
 /// `reference`, keeping only end states `guard` accepts (the last repair's: [`super::turned`]).
-/// Returns (neighbourhoods replaced, flips made).
+/// Returns what the pass did, including its planar re-triangulations ([`planar`]).
 pub(crate) fn guarded_flip_sequences(
     mesh: &mut TriMesh,
     reference: &dyn Reference,
@@ -200,10 +201,9 @@ pub(crate) fn guarded_flip_sequences(
     bad: &[u32],
     guard: &flip_search::GuardFn<'_>,
     progress: &Progress,
-) -> Result<(usize, usize)> {
+) -> Result<flip_search::SearchPass> {
     let ctx = Ctx { reference, fixed, locked };
-    let pass = flip_search::flip_sequences(mesh, &ctx, Some(guard), bad, progress)?;
-    Ok((pass.regions, pass.flips))
+    flip_search::flip_sequences(mesh, &ctx, Some(guard), bad, progress)
 }
 
 /// Flips non-locked edges of faces standing steeply on the surface ([`steep`]); returns the flips.
