@@ -65,8 +65,14 @@ enum Replaced {
     Planar,
 }
 
-/// The depth that marks a planar re-triangulation among the search's end states.
-const PLANAR_DEPTH: usize = usize::MAX;
+/// A state's badness ([`Patch::badness`]): turned, folded, fold energy.
+type Badness = (usize, usize, f64);
+
+/// Whether badness `new` is better than `old`: fewer turned or folded (lexicographically), or as
+/// many with less energy.
+fn improves(new: Badness, old: Badness) -> bool {
+    (new.0, new.1) < (old.0, old.1) || ((new.0, new.1) == (old.0, old.1) && new.2 < old.2 - 1e-12)
+}
 
 /// Cosine of face `t`'s normal with its reference (0 for a zero-area face): folded at or below
 /// [`MIN_COS`].
@@ -97,7 +103,7 @@ impl Patch {
     /// How bad the patch is, lexicographically: faces turned over or zero-area (what the report
     /// counts as flipped or zero-area), then faces folded (within [`MIN_COS`] of perpendicular, or
     /// beyond), then the summed fold energy.
-    fn badness(&self) -> (usize, usize, f64) {
+    fn badness(&self) -> Badness {
         let turned = self.quality.iter().filter(|&&q| q <= 0.0).count();
         let folded = self.quality.iter().filter(|&&q| q <= MIN_COS).count();
         (turned, folded, self.quality.iter().map(|&q| energy(q)).sum())
@@ -170,8 +176,8 @@ struct Search<'a> {
     ctx: &'a Ctx<'a>,
     guard: Guard<'a>,
     states: usize,
-    /// The best state seen: its badness, faces and depth (flips).
-    best: ((usize, usize, f64), Vec<[u32; 3]>, usize),
+    /// The best state seen: its badness, faces and how it was made.
+    best: (Badness, Vec<[u32; 3]>, Replaced),
 }
 
 impl Search<'_> {
@@ -179,13 +185,11 @@ impl Search<'_> {
     /// undoing the flip just made (`last`: the edge it made).
     fn visit(&mut self, patch: &mut Patch, depth: usize, max_depth: usize, last: (u32, u32)) {
         self.states += 1;
-        let (turned, folded, e) = patch.badness();
-        let (bt, bf, be) = self.best.0;
-        let better = (turned, folded) < (bt, bf) || ((turned, folded) == (bt, bf) && e < be - 1e-12);
-        if better
+        let badness = patch.badness();
+        if improves(badness, self.best.0)
             && self.guard.is_none_or(|g| depth == 0 || g(self.mesh, &patch.original, &patch.faces, false))
         {
-            self.best = ((turned, folded, e), patch.faces.clone(), depth);
+            self.best = (badness, patch.faces.clone(), Replaced::Flips(depth));
         }
         if depth == max_depth || self.best.0 .1 == 0 || self.states >= MAX_STATES {
             return;
@@ -227,7 +231,7 @@ fn repair_one(
     let quality_of: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
     let mut patch = Patch { original, faces, quality: quality_of };
     let before = patch.badness();
-    let mut search = Search { mesh, ctx, guard, states: 0, best: (before, Vec::new(), 0) };
+    let mut search = Search { mesh, ctx, guard, states: 0, best: (before, Vec::new(), Replaced::Flips(0)) };
     // Shortest sequences first: a fix by one or two flips changes least.
     for max_depth in 1..=MAX_DEPTH {
         search.visit(&mut patch, 0, max_depth, (u32::MAX, u32::MAX));
@@ -239,23 +243,16 @@ fn repair_one(
     // faces, a new triangulation of its vertices in its plane. Not in the untangling stages
     // before it (no guard): there the moves and splits that follow do better on what it would
     // take (session 24: cow twisted (auto) 35 -> 40 flips with it there too).
-    if search.best.0 .0 > 0 {
-        if let Some(g) = guard {
-            if let Some(faces) = planar::retriangulate(mesh, ctx, &patch.faces) {
-                let quality: Vec<f64> = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
-                let flat = Patch { original: patch.original.clone(), faces, quality };
-                let b = flat.badness();
-                let (bt, bf, be) = search.best.0;
-                let better = (b.0, b.1) < (bt, bf) || ((b.0, b.1) == (bt, bf) && b.2 < be - 1e-12);
-                if better && g(mesh, &flat.original, &flat.faces, true) {
-                    search.best = (b, flat.faces, PLANAR_DEPTH);
-                }
+    if let Some(g) = guard.filter(|_| search.best.0 .0 > 0) {
+        if let Some((badness, faces)) = planar_state(mesh, ctx, &patch.original, &patch.faces) {
+            if improves(badness, search.best.0) && g(mesh, &patch.original, &faces, true) {
+                search.best = (badness, faces, Replaced::Planar);
             }
         }
     }
     // Kept only with fewer faces turned over (or as many and fewer folded): a trade of two faces
     // standing on their edge (folded, not flipped) for one turned over is refused.
-    let ((turned, folded, _), new_faces, depth) = search.best;
+    let ((turned, folded, _), new_faces, replaced) = search.best;
     if (turned, folded) >= (before.0, before.1) || new_faces.is_empty() {
         return Err(patch.original);
     }
@@ -278,7 +275,21 @@ fn repair_one(
             }
         }
     }
-    Ok(if depth == PLANAR_DEPTH { Replaced::Planar } else { Replaced::Flips(depth) })
+    Ok(replaced)
+}
+
+/// The neighbourhood `faces` (ids `original`) triangulated anew in its plane
+/// ([`planar::retriangulate`]), with its badness.
+fn planar_state(
+    mesh: &TriMesh,
+    ctx: &Ctx,
+    original: &[u32],
+    faces: &[[u32; 3]],
+) -> Option<(Badness, Vec<[u32; 3]>)> {
+    let faces = planar::retriangulate(mesh, ctx, faces)?;
+    let quality = faces.iter().map(|&t| quality(mesh, ctx, t)).collect();
+    let flat = Patch { original: original.to_vec(), faces, quality };
+    Some((flat.badness(), flat.faces))
 }
 
 /// One pass over the folded faces `bad` (in id order): each one still folded gets its

@@ -88,14 +88,23 @@ pub(crate) struct RingFrame {
 impl RingFrame {
     /// None for a zero `n` or an empty ring.
     pub(crate) fn new(ring_edges: &[(Point3, Point3)], n: Point3) -> Option<Self> {
-        let n = normalize(n);
-        if n == [0.0; 3] || ring_edges.is_empty() {
+        if ring_edges.is_empty() {
             return None;
         }
         let o = scale(
             ring_edges.iter().fold([0.0; 3], |s, e| add(add(s, e.0), e.1)),
             0.5 / ring_edges.len() as f64,
         );
+        Self::at(o, n)
+    }
+
+    /// The frame through `o` across `n` ((u, w, n) right-handed, so a face turned along n runs
+    /// counter-clockwise in plane coordinates); None for a zero `n`.
+    pub(crate) fn at(o: Point3, n: Point3) -> Option<Self> {
+        let n = normalize(n);
+        if n == [0.0; 3] {
+            return None;
+        }
         let t = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
         let u = normalize(cross(n, t));
         Some(Self { o, u, w: cross(n, u) })

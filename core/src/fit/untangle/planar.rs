@@ -19,11 +19,11 @@
 
 use std::collections::HashSet;
 
-use crate::geometry::{add, cross, dot, norm2, normalize, scale, sub};
+use crate::geometry::{add, dot, norm2, normalize, scale};
 use crate::mesh::Point3;
 
 use super::super::trimesh::TriMesh;
-use super::Ctx;
+use super::{Ctx, RingFrame};
 
 /// Every vertex's normal must be within this cosine of the patch's mean normal: 0 accepts any
 /// vertex not turned beyond perpendicular (the faithfulness checks below decide; 0.7 rejected
@@ -49,23 +49,22 @@ pub(super) fn retriangulate(mesh: &TriMesh, ctx: &Ctx, faces: &[[u32; 3]]) -> Op
         return None;
     }
     let plane = Plane::project(mesh, ctx, &verts)?;
-    let local = |v: u32| verts.iter().position(|&w| w == v);
-    let loop_local: Vec<usize> = ring.iter().filter_map(|&v| local(v)).collect();
+    // Local ids: `verts` starts with the loop, so the loop is local 0..n in order.
+    let n = ring.len();
+    let loop_local: Vec<usize> = (0..n).collect();
     plane.check_loop(&loop_local)?;
-    for i in ring.len()..verts.len() {
-        if !plane.strictly_inside(&loop_local, plane.pts[i]) {
-            return None;
-        }
+    if (n..verts.len()).any(|i| !plane.strictly_inside(&loop_local, plane.pts[i])) {
+        return None;
     }
+    let local = |v: u32| verts.iter().position(|&w| w == v);
+    let on_loop = |i: usize, j: usize| i < n && j < n && (j == (i + 1) % n || i == (j + 1) % n);
     let patch_edges: HashSet<(u32, u32)> = faces.iter().flat_map(|t| edges_of(*t)).collect();
-    let mut fixed: Vec<(usize, usize)> =
-        (0..loop_local.len()).map(|k| (loop_local[k], loop_local[(k + 1) % loop_local.len()])).collect();
+    let mut fixed: Vec<(usize, usize)> = (0..n).map(|k| (k, (k + 1) % n)).collect();
     let mut sorted_edges: Vec<(u32, u32)> = patch_edges.iter().copied().collect();
     sorted_edges.sort_unstable();
     for &(a, b) in &sorted_edges {
         let (Some(i), Some(j)) = (local(a), local(b)) else { return None };
-        let on_loop = fixed.iter().any(|&(x, y)| (x, y) == (i, j) || (x, y) == (j, i));
-        if ctx.locked(a, b) && !on_loop {
+        if ctx.locked(a, b) && !on_loop(i, j) {
             if !plane.admissible(&loop_local, &fixed, i, j) {
                 return None;
             }
@@ -156,23 +155,13 @@ impl Plane {
         if norm2(n) == 0.0 || normals.iter().any(|&m| dot(m, n) <= MIN_PLANE_COS) {
             return None;
         }
-        // Any unit vector across n, then the third axis: (u, w, n) is right-handed, so a face
-        // turned the right way (normal along n) runs counter-clockwise in (u, w).
-        let seed = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-        let u = normalize(cross(seed, n));
-        let w = cross(n, u);
         let centroid = scale(
             verts.iter().fold([0.0; 3], |s, &v| add(s, mesh.pos[v as usize])),
             1.0 / verts.len() as f64,
         );
-        let pts: Vec<[f64; 2]> = verts
-            .iter()
-            .map(|&v| {
-                let d = sub(mesh.pos[v as usize], centroid);
-                [dot(d, u), dot(d, w)]
-            })
-            .collect();
-        let size2 = pts.iter().map(|p| p[0] * p[0] + p[1] * p[1]).fold(0.0, f64::max);
+        let frame = RingFrame::at(centroid, n)?;
+        let pts: Vec<[f64; 2]> = verts.iter().map(|&v| frame.flat(mesh.pos[v as usize])).collect();
+        let size2 = pts.iter().map(|&p| norm2_2(p)).fold(0.0, f64::max);
         (size2 > 0.0).then_some(Plane { pts, eps: EPS_REL * size2 })
     }
 
